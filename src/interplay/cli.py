@@ -1,0 +1,153 @@
+"""The ``interplay`` command: list, run, compare and fit-standin.
+
+Errors a user can cause print one line (no traceback) and exit with status 2.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .errors import InterplayError, ParameterError
+
+MODES = ("two-way", "one-way", "hybrid")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, not usage + traceback
+        print(f"interplay: error: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _scene_options(p):
+    p.add_argument("scene", help="scene name (see `interplay list`)")
+    p.add_argument("--duration", type=float, default=None, help="simulated seconds")
+    p.add_argument("--fps", type=float, default=60.0, help="output frames per second")
+    p.add_argument("--integrator", default=None, help="explicit | implicit (spring-mass systems)")
+    p.add_argument("--dt", type=float, default=None, help="spring-mass step in seconds")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene parameter, e.g. --set net.cord_ea=300")
+    p.add_argument("--out", default=None, help="output directory (default out/SCENE)")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def _parser():
+    ap = _Parser(prog="interplay", description="Secondary motion by coupled simulations.")
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub.add_parser("list", help="list the scenes")
+    run = sub.add_parser("run", help="simulate one scene in one coupling mode")
+    _scene_options(run)
+    run.add_argument("--coupling", default="two-way", help="two-way | one-way | hybrid")
+    cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
+    _scene_options(cmp_)
+    fit = sub.add_parser("fit-standin", help="fit the hybrid stand-in to a two-way run")
+    _scene_options(fit)
+    return ap
+
+
+def _build_kwargs(args):
+    from . import params as P
+    from .scenes import load
+    module = load(args.scene)
+    assignments = {}
+    for item in args.sets:
+        key, eq, value = item.partition("=")
+        if not eq or not key:
+            raise ParameterError(f"--set {item}: expected KEY=VALUE")
+        assignments[key.strip()] = value.strip()
+    kw = {"params": P.apply(module.PARAMS(), assignments), "fps": args.fps}
+    if args.duration is not None:
+        kw["duration"] = args.duration
+    if args.integrator is not None:
+        if args.integrator not in ("explicit", "implicit"):
+            raise ParameterError(f"--integrator {args.integrator}: choose explicit or implicit")
+        kw["integrator"] = args.integrator
+    if args.dt is not None:
+        kw["dt"] = args.dt
+    return module, kw
+
+
+def _check_mode(mode):
+    if mode not in MODES:
+        raise ParameterError(f"--coupling {mode}: unknown coupling; choose one of "
+                             f"{', '.join(MODES)}")
+
+
+def _run_one(module, mode, kw, out, quiet, console):
+    from .progress import PassProgress
+    scene = module.build(mode, **kw)
+    result = scene.simulate(progress=PassProgress(scene.duration, quiet))
+    paths = result.save(out)
+    return result, paths
+
+
+def cmd_list(args, console):
+    from .scenes import REGISTRY
+    for name, (_, text) in sorted(REGISTRY.items()):
+        console.print(f"[bold]{name}[/bold]  {text}")
+
+
+def cmd_run(args, console):
+    _check_mode(args.coupling)
+    module, kw = _build_kwargs(args)
+    out = Path(args.out or f"out/{args.scene}")
+    result, paths = _run_one(module, args.coupling, kw, out, args.quiet, console)
+    from .report_text import print_run
+    print_run(console, result)
+    for p in paths:
+        console.print(f"wrote {p}")
+
+
+def cmd_compare(args, console):
+    from .compare import compare_modes
+    module, kw = _build_kwargs(args)
+    out = Path(args.out or f"out/{args.scene}")
+    compare_modes(module, kw, out, args.quiet, console)
+
+
+def cmd_fit(args, console):
+    from .fitting import fit_standin
+    from .io.atomic import atomic_path
+    module, kw = _build_kwargs(args)
+    if not hasattr(module, "STANDIN"):
+        raise ParameterError(f"scene {args.scene} has no hybrid stand-in to fit")
+    params = kw.pop("params")
+    console.print("running the two-way reference, then fitting the stand-in ...")
+    fit = fit_standin(module, params, **kw)
+    console.print(f"fitted {module.STANDIN}.linear = {fit['linear']:.6g} N s/m, "
+                  f"{module.STANDIN}.angular = {fit['angular']:.6g} N m s")
+    console.print(f"velocity at t={fit['fit_time_s']} s: two-way "
+                  f"{_vec(fit['two_way_velocity'])} m/s, hybrid {_vec(fit['hybrid_velocity'])} "
+                  f"m/s: speed error {100 * fit['speed_error_rel']:.2f}%, direction off by "
+                  f"{fit['direction_error_deg']:.1f} deg ({fit['spin']})")
+    out = Path(args.out or f"out/{args.scene}") / "standin_fit.json"
+    with atomic_path(out) as tmp:
+        tmp.write_text(json.dumps(fit, indent=2))
+    console.print(f"wrote {out}")
+
+
+def _vec(v):
+    return "(" + ", ".join(f"{x:.3f}" for x in v) + ")"
+
+
+COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit}
+
+
+def main(argv=None) -> int:
+    from rich.console import Console
+    args = _parser().parse_args(argv)
+    console = Console()
+    try:
+        COMMANDS[args.command](args, console)
+    except InterplayError as e:
+        print(f"interplay: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interplay: interrupted", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

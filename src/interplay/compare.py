@@ -1,0 +1,66 @@
+"""`interplay compare`: the three coupling modes side by side (the paper's Figure 2)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .io.atomic import atomic_path
+from .progress import PassProgress
+from .report_text import mode_row
+
+MODES = ("two-way", "one-way", "hybrid")
+
+
+def compare_modes(module, kw, out: Path, quiet: bool, console) -> dict:
+    """Run every mode, save each under out/MODE, print one table, write out/compare.json."""
+    results = {}
+    for mode in MODES:
+        if not quiet:
+            console.print(f"[bold]{mode}[/bold] ...")
+        scene = module.build(mode, **kw)
+        results[mode] = scene.simulate(progress=PassProgress(scene.duration, quiet))
+    one_way_stable = not any(results["one-way"].warnings)
+    two_way_cost = results["two-way"].total_s
+    rows, paths = {}, []
+    for mode, r in results.items():
+        summary = r.summary(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
+        paths += r.save(out / mode, summary)
+        rows[mode] = mode_row(r)
+    advice = results["two-way"].advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
+    report = {"scene": results["two-way"].scene.name, "modes": rows, "advice": advice}
+    path = out / "compare.json"
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(report, indent=2))
+    _print_table(console, rows, advice)
+    for p in paths + [path]:
+        console.print(f"wrote {p}")
+    return report
+
+
+def _print_table(console, rows, advice):
+    from rich.table import Table
+    table = Table(title="coupling modes side by side")
+    for col in ("", *rows):
+        table.add_column(col, justify="right")
+
+    def line(label, fn):
+        table.add_row(label, *(fn(r) for r in rows.values()))
+
+    line("exit speed (m/s)", lambda r: f"{r['exit_speed']:.3f}" if "exit_speed" in r else "-")
+    line("free-flight speed then (m/s)",
+         lambda r: f"{r['free_flight_exit_speed']:.3f}" if "exit_speed" in r else "-")
+    line("exit velocity (m/s)", lambda r: ", ".join(f"{v:.2f}" for v in r["exit_velocity"])
+         if "exit_velocity" in r else "-")
+    line("max secondary strain", lambda r: f"{100 * r['max_strain']:.1f}%"
+         if r["max_strain"] is not None else "-")
+    line("force min/max/mean (N)", lambda r: "{min:.1f}/{max:.1f}/{mean:.1f}".format(**r["force_N"]))
+    line("accel. min/max/mean (m/s^2)",
+         lambda r: "{min:.2f}/{max:.2f}/{mean:.2f}".format(**r["acceleration_m_s2"]))
+    line("primary debug cycle (s)", lambda r: f"{r['primary_cycle_s']:.3f}")
+    line("total wall time (s)", lambda r: f"{r['total_s']:.3f}")
+    line("warnings", lambda r: str(len(r["warnings"])))
+    console.print(table)
+    console.print(f"advice: [bold]{advice['mode']}[/bold] - " + "; ".join(advice["reasons"]))
+    for mode, r in rows.items():
+        for w in r["warnings"]:
+            console.print(f"[yellow]{mode}:[/yellow] {w}")

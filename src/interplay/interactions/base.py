@@ -1,0 +1,73 @@
+"""The Interaction protocol and coupling modes (SPEC 1).
+
+An interaction joins a *primary* (the active system: a ball, a figure) and a *secondary* (the
+passive one: a net, water). ``exchange(to_primary, to_secondary)`` computes the forces from
+both systems' current states, applies them to the sides asked for, and returns the force
+(N) and torque (N m, about the primary's centre) the interaction exerts on the primary,
+whether or not it was applied, so the analysis can measure what the primary would feel.
+
+Modes: ``two-way`` applies both sides in lock step; ``one-way`` runs the primary alone first and
+applies forces to the secondary only, against playback of the primary's track; ``hybrid`` is
+one-way with a ``StandIn`` acting on the primary in its own pass.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SceneError
+
+MODES = ("two-way", "one-way", "hybrid")
+
+
+class StandIn:
+    """A cheap substitute for an interaction that acts on the primary alone (hybrid coupling)."""
+
+    name = "stand-in"
+
+    def act(self, primary) -> tuple[np.ndarray, np.ndarray, bool]:
+        """Apply the stand-in force to the primary; return (force N, torque N m, active)."""
+        raise NotImplementedError(f"{type(self).__name__} does not implement act()")
+
+
+class Interaction:
+    """Base class: a named force exchange between ``primary`` and ``secondary``."""
+
+    def __init__(self, name: str, primary, secondary, mode: str = "two-way",
+                 standin: StandIn | None = None):
+        self.name = name
+        self.primary = primary
+        self.secondary = secondary
+        self.standin = standin
+        self.mode = mode
+
+    @property
+    def mode(self) -> str:
+        return self._mode
+
+    @mode.setter
+    def mode(self, mode: str):
+        if mode not in MODES:
+            raise SceneError(f"interaction {self.name}: unknown coupling {mode!r}; "
+                             f"choose one of {', '.join(MODES)}")
+        if mode == "hybrid" and self.standin is None:
+            raise SceneError(f"interaction {self.name}: hybrid coupling needs a stand-in "
+                             "(none is defined for it); use two-way or one-way")
+        self._mode = mode
+
+    def prepare(self, h: float) -> None:
+        """Called at the start of each pass with its coupling step h (s)."""
+
+    def exchange(self, to_primary: bool, to_secondary: bool):
+        """Compute the forces, apply them where asked; return (force, torque, in_contact).
+
+        An interaction that integrates its force over the secondary's substeps returns None
+        instead; the scheduler then advances the secondary first and calls ``complete``."""
+        raise NotImplementedError(f"{type(self).__name__} does not implement exchange()")
+
+    def complete(self, to_primary: bool):
+        """Finish a deferred exchange after the secondary advanced; return as ``exchange``."""
+        raise NotImplementedError(f"{type(self).__name__} does not defer its exchange")
+
+    def describe(self) -> dict:
+        return {"name": self.name, "primary": self.primary.name,
+                "secondary": self.secondary.name, "mode": self.mode}

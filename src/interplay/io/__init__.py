@@ -1,0 +1,1 @@
+"""Files an animator opens, written atomically."""

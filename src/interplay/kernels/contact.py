@@ -1,0 +1,159 @@
+"""Contact kernels: a sphere against cord segments and against a plane (SPEC 2.5 response).
+
+Normal force f_n = f_c + c_s p + c_d pdot (clamped at zero: contacts push, never pull), where p
+is the penetration depth (m), pdot its rate (m/s), and f_c the constraint term: the force that
+cancels the relative acceleration (from all other forces) pushing the two bodies together,
+f_c = -m_eff min(0, a_rel.n) with m_eff the pair's reduced mass at the contact point.
+Friction is regularized Coulomb: f_t = -mu f_n min(1, |v_t|/eps) v_t/|v_t|.
+"""
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def _closest_param(cx, cy, cz, ax, ay, az, bx, by, bz):
+    """Parameter t in [0,1] of the point of segment a-b closest to c (scalars: no allocation)."""
+    ex, ey, ez = bx - ax, by - ay, bz - az
+    L2 = ex * ex + ey * ey + ez * ez
+    if L2 <= 0.0:
+        return 0.0
+    t = ((cx - ax) * ex + (cy - ay) * ey + (cz - az) * ez) / L2
+    return min(1.0, max(0.0, t))
+
+
+@njit(cache=True, inline="always")
+def _far(c, reach, x, ia, ib):
+    """True when the segment's bounding box misses the sphere's: a cheap early rejection."""
+    for r in range(3):
+        lo = min(x[ia, r], x[ib, r])
+        hi = max(x[ia, r], x[ib, r])
+        if c[r] + reach < lo or c[r] - reach > hi:
+            return True
+    return False
+
+
+@njit(cache=True)
+def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg, thickness,
+                    cs, cd, mu, eps, constraint, out_idx, out_f, out_dfdx, out_dfdv, out_vref,
+                    ball_wrench):
+    """Contacts of a sphere (centre c, velocity vc, angular velocity w) with segments of points.
+
+    Writes forces on the segment end points (equal and opposite to the ball's, split by the
+    closest-point weights) with their 3x3 Jacobians for implicit integrators and the velocity of
+    the ball's surface at the contact (what the penetration is relative to) into out_*,
+    and the total force (0:3) and torque about the centre (3:6) on the ball into ball_wrench.
+    Returns the number of point entries written (2 per touching segment).
+    """
+    for q in range(6):
+        ball_wrench[q] = 0.0
+    reach = radius + thickness
+    k = 0
+    for s in range(seg.shape[0]):
+        ia = seg[s, 0]
+        ib = seg[s, 1]
+        if _far(c, reach, x, ia, ib):
+            continue
+        t = _closest_param(c[0], c[1], c[2], x[ia, 0], x[ia, 1], x[ia, 2],
+                           x[ib, 0], x[ib, 1], x[ib, 2])
+        dx = c[0] - (x[ia, 0] + t * (x[ib, 0] - x[ia, 0]))
+        dy = c[1] - (x[ia, 1] + t * (x[ib, 1] - x[ia, 1]))
+        dz = c[2] - (x[ia, 2] + t * (x[ib, 2] - x[ia, 2]))
+        d2 = dx * dx + dy * dy + dz * dz
+        if d2 >= reach * reach or d2 <= 0.0:
+            continue
+        dist = np.sqrt(d2)
+        pen = reach - dist
+        n = np.array([dx / dist, dy / dist, dz / dist])
+        r = -radius * n
+        vball = vc + np.cross(w, r)
+        vcord = (1.0 - t) * v[ia] + t * v[ib]
+        vrel = vball - vcord
+        vn = vrel[0] * n[0] + vrel[1] * n[1] + vrel[2] * n[2]
+        fn = cs * pen - cd * vn
+        wa = 1.0 - t
+        wb = t
+        if constraint:
+            arel = ball_acc - (wa * pt_acc[ia] + wb * pt_acc[ib])
+            an = arel[0] * n[0] + arel[1] * n[1] + arel[2] * n[2]
+            if an < 0.0:
+                inv_m = 1.0 / ball_mass + wa * wa / m[ia] + wb * wb / m[ib]
+                fn += -an / inv_m
+        if fn <= 0.0:
+            continue
+        vt = vrel - vn * n
+        vtn = np.sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2])
+        ft = np.zeros(3)
+        slip = 1.0
+        if vtn > 0.0:
+            slip = min(1.0, vtn / eps)
+            ft = (-mu * fn * slip / vtn) * vt
+        F = fn * n + ft
+        tau = np.cross(r, F)
+        for q in range(3):
+            ball_wrench[q] += F[q]
+            ball_wrench[3 + q] += tau[q]
+        # Jacobians of the point forces: penalty along n; damping along n; friction in the
+        # tangent plane while it is in its viscous (regularized) range.
+        visc = mu * fn / eps if vtn < eps else 0.0
+        for side in range(2):
+            p = ia if side == 0 else ib
+            wgt = wa if side == 0 else wb
+            out_idx[k] = p
+            for a in range(3):
+                out_vref[k, a] = vball[a]
+            for a in range(3):
+                out_f[k, a] = -wgt * F[a]
+                for b in range(3):
+                    nn = n[a] * n[b]
+                    out_dfdx[k, a, b] = -wgt * wgt * cs * nn
+                    tan = (1.0 if a == b else 0.0) - nn
+                    out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
+            k += 1
+    return k
+
+
+@njit(cache=True)
+def sphere_plane(c, vc, w, radius, mass, acc_n, height, cs, cd, mu, eps, wrench):
+    """A sphere on the plane z = height (normal +z). acc_n: the sphere's free acceleration
+    along +z (m/s^2). Writes force (0:3) and torque (3:6) on the sphere; returns True on contact."""
+    for q in range(6):
+        wrench[q] = 0.0
+    pen = radius - (c[2] - height)
+    if pen <= 0.0:
+        return False
+    n = np.array([0.0, 0.0, 1.0])
+    r = -radius * n
+    vp = vc + np.cross(w, r)
+    fn = cs * pen - cd * vp[2]
+    if acc_n < 0.0:
+        fn += -mass * acc_n
+    if fn <= 0.0:
+        return False
+    vt = vp - vp[2] * n
+    vtn = np.sqrt(vt[0] * vt[0] + vt[1] * vt[1])
+    F = fn * n
+    if vtn > 0.0:
+        F = F - (mu * fn * min(1.0, vtn / eps) / vtn) * vt
+    tau = np.cross(r, F)
+    for q in range(3):
+        wrench[q] = F[q]
+        wrench[3 + q] = tau[q]
+    return True
+
+
+@njit(cache=True)
+def sphere_segment_overlap(c, radius, x, seg, reach):
+    """Sum over segments of the sphere's penetration depth into each, as a fraction of radius."""
+    total = 0.0
+    for s in range(seg.shape[0]):
+        ia = seg[s, 0]
+        ib = seg[s, 1]
+        t = _closest_param(c[0], c[1], c[2], x[ia, 0], x[ia, 1], x[ia, 2],
+                           x[ib, 0], x[ib, 1], x[ib, 2])
+        dx = c[0] - (x[ia, 0] + t * (x[ib, 0] - x[ia, 0]))
+        dy = c[1] - (x[ia, 1] + t * (x[ib, 1] - x[ia, 1]))
+        dz = c[2] - (x[ia, 2] + t * (x[ib, 2] - x[ia, 2]))
+        d2 = dx * dx + dy * dy + dz * dz
+        if d2 < reach * reach:
+            total += (reach - np.sqrt(d2)) / radius
+    return total

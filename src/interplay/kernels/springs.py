@@ -1,0 +1,287 @@
+"""Spring-mass network kernels: forces, the explicit (symplectic Euler) step, and the implicit
+backward-Euler step with one Newton iteration solved by preconditioned conjugate gradients
+(Baraff & Witkin 1998).
+
+Notation (SI): x, v (n,3) positions m and velocities m/s; m (n,) kg; springs (si, sj) with rest
+length l0 (m), stiffness k (N/m), along-spring damping kd (N s/m), tension_only flags; anchors
+are zero-rest-length springs from a point to a world position (k N/m, c N s/m); alpha (1/s) is
+the mass-proportional Rayleigh coefficient (force -alpha m v). ``fixed`` points never move: the
+implicit solve filters them out of the system (constraint filter), the explicit step skips them.
+"""
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, fastmath=True)
+def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
+                   alpha, gravity, fext, f):
+    """Total force (N) on each point: springs, anchors, Rayleigh mass damping, gravity, external."""
+    n = x.shape[0]
+    for p in range(n):
+        for c in range(3):
+            f[p, c] = fext[p, c] + m[p] * (gravity[c] - alpha * v[p, c])
+    for s in range(si.shape[0]):
+        a = si[s]
+        b = sj[s]
+        d0 = x[a, 0] - x[b, 0]
+        d1 = x[a, 1] - x[b, 1]
+        d2 = x[a, 2] - x[b, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if ln <= 0.0 or (tension_only[s] and ln < l0[s]):
+            continue
+        u0 = d0 / ln
+        u1 = d1 / ln
+        u2 = d2 / ln
+        vr = (v[a, 0] - v[b, 0]) * u0 + (v[a, 1] - v[b, 1]) * u1 + (v[a, 2] - v[b, 2]) * u2
+        mag = -k[s] * (ln - l0[s]) - kd[s] * vr
+        f[a, 0] += mag * u0
+        f[a, 1] += mag * u1
+        f[a, 2] += mag * u2
+        f[b, 0] -= mag * u0
+        f[b, 1] -= mag * u1
+        f[b, 2] -= mag * u2
+    for r in range(a_idx.shape[0]):
+        p = a_idx[r]
+        for c in range(3):
+            f[p, c] += -a_k[r] * (x[p, c] - a_pos[r, c]) - a_c[r] * v[p, c]
+
+
+@njit(cache=True)
+def explicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
+                  alpha, gravity, fext, f, h, nsteps):
+    """nsteps symplectic-Euler steps of h seconds (v += h f/m, then x += h v), fext held."""
+    n = x.shape[0]
+    for _ in range(nsteps):
+        network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
+                       alpha, gravity, fext, f)
+        for p in range(n):
+            if fixed[p]:
+                continue
+            for c in range(3):
+                v[p, c] += h * f[p, c] / m[p]
+                x[p, c] += h * v[p, c]
+
+
+@njit(cache=True)
+def _spring_blocks(x, si, sj, l0, k, kd, tension_only, h, C, Kblk):
+    """Per-spring blocks: Kblk = d f_a / d x_a, C = h D_s + h^2 K_s (negative semidefinite).
+
+    The transverse term k (1 - l0/l) is clamped at zero for compressed springs so the system
+    stays positive definite (Baraff & Witkin's advice); slack tension-only cords contribute 0.
+    """
+    for s in range(si.shape[0]):
+        a = si[s]
+        b = sj[s]
+        d0 = x[a, 0] - x[b, 0]
+        d1 = x[a, 1] - x[b, 1]
+        d2 = x[a, 2] - x[b, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        for r in range(3):
+            for c in range(3):
+                C[s, r, c] = 0.0
+                Kblk[s, r, c] = 0.0
+        if ln <= 0.0 or (tension_only[s] and ln < l0[s]):
+            continue
+        u = (d0 / ln, d1 / ln, d2 / ln)
+        t = 1.0 - l0[s] / ln
+        if t < 0.0:
+            t = 0.0
+        for r in range(3):
+            for c in range(3):
+                uu = u[r] * u[c]
+                eye = 1.0 if r == c else 0.0
+                ks = -k[s] * (uu + t * (eye - uu))
+                Kblk[s, r, c] = ks
+                C[s, r, c] = h * (-kd[s] * uu) + h * h * ks
+
+
+@njit(cache=True)
+def _apply_A(p, diag, si, sj, C, fixed, out):
+    """out = A p with A = blockdiag(diag) - sum over springs of the +-C couplings; fixed rows 0."""
+    n = p.shape[0]
+    for i in range(n):
+        for r in range(3):
+            out[i, r] = diag[i, r, 0] * p[i, 0] + diag[i, r, 1] * p[i, 1] + diag[i, r, 2] * p[i, 2]
+    for s in range(si.shape[0]):
+        a = si[s]
+        b = sj[s]
+        for r in range(3):
+            y = 0.0
+            for c in range(3):
+                y += C[s, r, c] * (p[a, c] - p[b, c])
+            out[a, r] -= y
+            out[b, r] += y
+    for i in range(n):
+        if fixed[i]:
+            out[i, 0] = 0.0
+            out[i, 1] = 0.0
+            out[i, 2] = 0.0
+
+
+@njit(cache=True)
+def _inv3(A, out):
+    """Inverse of a 3x3 matrix by cofactors (LAPACK calls cost microseconds each here)."""
+    a, b, c = A[0, 0], A[0, 1], A[0, 2]
+    d, e, f = A[1, 0], A[1, 1], A[1, 2]
+    g, h, i = A[2, 0], A[2, 1], A[2, 2]
+    co0, co1, co2 = e * i - f * h, f * g - d * i, d * h - e * g
+    inv_det = 1.0 / (a * co0 + b * co1 + c * co2)
+    out[0, 0], out[0, 1], out[0, 2] = co0 * inv_det, (c * h - b * i) * inv_det, (b * f - c * e) * inv_det
+    out[1, 0], out[1, 1], out[1, 2] = co1 * inv_det, (a * i - c * g) * inv_det, (c * d - a * f) * inv_det
+    out[2, 0], out[2, 1], out[2, 2] = co2 * inv_det, (b * g - a * h) * inv_det, (a * e - b * d) * inv_det
+
+
+@njit(cache=True)
+def _precondition(Pinv, r, z):
+    for i in range(r.shape[0]):
+        for a in range(3):
+            z[i, a] = Pinv[i, a, 0] * r[i, 0] + Pinv[i, a, 1] * r[i, 1] + Pinv[i, a, 2] * r[i, 2]
+
+
+@njit(cache=True)
+def _dot(a, b):
+    s = 0.0
+    for i in range(a.shape[0]):
+        s += a[i, 0] * b[i, 0] + a[i, 1] * b[i, 1] + a[i, 2] * b[i, 2]
+    return s
+
+
+@njit(cache=True)
+def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
+                  alpha, gravity, fext, kext, dext, kvref, f, h, theta, tol, max_iter):
+    """One implicit step with one Newton iteration of the theta-method:
+
+        (M - theta h D - theta^2 h^2 K) dv = h (f + theta h K v),  x += h (v + theta dv).
+
+    theta = 1 is backward Euler (Baraff & Witkin), which damps every mode with omega h >~ 1;
+    theta = 1/2 is the trapezoidal rule (no numerical damping); in between damps less.
+
+    kext, dext (n,3,3) are the external forces' own Jacobians d f / d x and d f / d v (diagonal
+    blocks, e.g. from penalty contacts), so stiff couplings stay stable at large h. An external
+    force that depends on the point's position *relative to another body* moving at v_ref
+    (a contact) enters as kext (v - v_ref): kvref (n,3) holds the sum of kext v_ref, so the
+    point follows the other body through the step instead of lagging a step behind. Solved by
+    block-Jacobi preconditioned CG to a relative residual ``tol``. Returns the CG iterations.
+    """
+    n = x.shape[0]
+    ns = si.shape[0]
+    network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
+                   alpha, gravity, fext, f)
+    C = np.empty((ns, 3, 3))
+    Kblk = np.empty((ns, 3, 3))
+    hs = theta * h
+    _spring_blocks(x, si, sj, l0, k, kd, tension_only, hs, C, Kblk)
+    # diagonal blocks of A not coming from springs: M - h D_diag - h^2 K_diag
+    diag = np.zeros((n, 3, 3))
+    for i in range(n):
+        for r in range(3):
+            for c in range(3):
+                diag[i, r, c] = -hs * dext[i, r, c] - hs * hs * kext[i, r, c]
+            diag[i, r, r] += m[i] * (1.0 + hs * alpha)
+    for q in range(a_idx.shape[0]):
+        i = a_idx[q]
+        for r in range(3):
+            diag[i, r, r] += hs * a_c[q] + hs * hs * a_k[q]
+    # right-hand side b = h (f + theta h K v)
+    b = np.empty((n, 3))
+    for i in range(n):
+        for r in range(3):
+            kv = 0.0
+            for c in range(3):
+                kv += kext[i, r, c] * v[i, c]
+            b[i, r] = h * (f[i, r] + hs * (kv - kvref[i, r]))
+    for q in range(a_idx.shape[0]):
+        i = a_idx[q]
+        for r in range(3):
+            b[i, r] += h * hs * (-a_k[q] * v[i, r])
+    for s in range(ns):
+        a = si[s]
+        bb = sj[s]
+        for r in range(3):
+            kv = 0.0
+            for c in range(3):
+                kv += Kblk[s, r, c] * (v[a, c] - v[bb, c])
+            b[a, r] += h * hs * kv
+            b[bb, r] -= h * hs * kv
+    # block-Jacobi preconditioner: inverse of each point's full diagonal block
+    P = diag.copy()
+    for s in range(ns):
+        for r in range(3):
+            for c in range(3):
+                P[si[s], r, c] -= C[s, r, c]
+                P[sj[s], r, c] -= C[s, r, c]
+    Pinv = np.empty((n, 3, 3))
+    for i in range(n):
+        _inv3(P[i], Pinv[i])
+    for i in range(n):
+        if fixed[i]:
+            b[i, 0] = 0.0
+            b[i, 1] = 0.0
+            b[i, 2] = 0.0
+    # preconditioned conjugate gradients with the constraint filter
+    dv = np.zeros((n, 3))
+    r_ = b.copy()
+    z = np.empty((n, 3))
+    _precondition(Pinv, r_, z)
+    pdir = z.copy()
+    Ap = np.empty((n, 3))
+    rz = _dot(r_, z)
+    bnorm = np.sqrt(_dot(b, b))
+    it = 0
+    if bnorm > 0.0:
+        while it < max_iter:
+            _apply_A(pdir, diag, si, sj, C, fixed, Ap)
+            alpha_cg = rz / _dot(pdir, Ap)
+            for i in range(n):
+                for a in range(3):
+                    dv[i, a] += alpha_cg * pdir[i, a]
+                    r_[i, a] -= alpha_cg * Ap[i, a]
+            it += 1
+            if np.sqrt(_dot(r_, r_)) <= tol * bnorm:
+                break
+            _precondition(Pinv, r_, z)
+            rz_new = _dot(r_, z)
+            beta = rz_new / rz
+            for i in range(n):
+                for a in range(3):
+                    pdir[i, a] = z[i, a] + beta * pdir[i, a]
+            rz = rz_new
+    for i in range(n):
+        if fixed[i]:
+            continue
+        for c in range(3):
+            x[i, c] += h * (v[i, c] + theta * dv[i, c])
+            v[i, c] += dv[i, c]
+    return it
+
+
+@njit(cache=True)
+def max_strain(x, si, sj, l0):
+    """Largest (l - l0) / l0 over all springs."""
+    best = -1.0
+    for s in range(si.shape[0]):
+        a, b = si[s], sj[s]
+        d0 = x[a, 0] - x[b, 0]
+        d1 = x[a, 1] - x[b, 1]
+        d2 = x[a, 2] - x[b, 2]
+        e = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) / l0[s] - 1.0
+        if e > best:
+            best = e
+    return best
+
+
+@njit(cache=True)
+def scatter_forces(idx, forces, dfdx, dfdv, vref, fext, kext, dext, kvref, with_jacobian):
+    """Accumulate point forces, their 3x3 Jacobian blocks and kext v_ref into the buffers."""
+    for r in range(idx.shape[0]):
+        p = idx[r]
+        for c in range(3):
+            fext[p, c] += forces[r, c]
+        if with_jacobian:
+            for a in range(3):
+                kv = 0.0
+                for c in range(3):
+                    kext[p, a, c] += dfdx[r, a, c]
+                    dext[p, a, c] += dfdv[r, a, c]
+                    kv += dfdx[r, a, c] * vref[r, c]
+                kvref[p, a] += kv

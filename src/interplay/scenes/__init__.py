@@ -1,0 +1,19 @@
+"""The gallery: one module per scene, each with ``build(**params) -> Scene``."""
+from __future__ import annotations
+
+import importlib
+
+from ..errors import SceneError
+
+#: scene name -> (module, one-line description)
+REGISTRY = {
+    "basketball": ("basketball", "a basketball falls through a spring-mass net (two-way, "
+                                 "one-way or hybrid)"),
+}
+
+
+def load(name: str):
+    """The scene module for ``name``; SceneError listing the known scenes otherwise."""
+    if name not in REGISTRY:
+        raise SceneError(f"unknown scene {name!r}; known scenes: {', '.join(sorted(REGISTRY))}")
+    return importlib.import_module(f"{__name__}.{REGISTRY[name][0]}")

@@ -1,0 +1,70 @@
+"""A basketball through a net (the paper's Figure 2): a rigid ball falls through a spring-mass
+net hung from a fixed rim, coupled two-way, one-way or hybrid (a damping field stand-in)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+from ..geometry.net import NetParams, basketball_net
+from ..interactions.contact import ContactParams, SphereCordContact, SpherePlaneContact
+from ..interactions.standins import DampingField, DampingFieldParams
+from ..scene import Scene
+from ..systems.rigid import Sphere, SphereParams
+from ..systems.static import StaticPlane
+
+
+@dataclass(frozen=True)
+class BallParams(SphereParams):
+    """The ball: a regulation basketball, hollow shell. position m, velocity m/s, spin rad/s."""
+    position: tuple = (0.02, 0.0, 3.65)
+    velocity: tuple = (0.3, 0.0, -1.0)
+    spin: tuple = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class BasketballParams:
+    ball: BallParams = BallParams()
+    net: NetParams = NetParams()
+    # nylon cord on a rubber ball; light contact damping so impacts do not spike the force
+    contact: ContactParams = ContactParams(stiffness=2.0e3, damping=0.5, friction=1.0)
+    # floor: stiff enough to stop a 7 m/s ball within ~2 cm; damping for restitution ~0.75
+    floor: ContactParams = ContactParams(stiffness=1.0e5, damping=40.0, friction=0.6,
+                                         eps=0.05, thickness=0.0)
+    field: DampingFieldParams = DampingFieldParams()
+    settle: bool = True  # let the net sag to rest under gravity before t = 0
+    # s: forces are exchanged every coupling_dt; the net sub-cycles the ball contact inside it.
+    # Set it to the net's dt for strict lock step (the reference).
+    coupling_dt: float = 1e-3
+
+
+PARAMS = BasketballParams
+STANDIN = "field"  # the params field holding the hybrid stand-in's coefficients
+FIT_TIME = 0.6  # s: the ball has left the net and not yet reached the floor
+CHECKPOINTS = [0.2, 0.3, 0.4, 0.5, 0.6]  # s, the ball's state is reported at these times
+
+
+def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
+          integrator: str | None = None, dt: float | None = None,
+          params: BasketballParams = BasketballParams()) -> Scene:
+    """The scene. integrator and dt override the net's (dt in s)."""
+    net_p = params.net
+    if integrator is not None:
+        net_p = replace(net_p, integrator=integrator)
+    if dt is not None:
+        net_p = replace(net_p, dt=dt)
+    b = params.ball
+    scene = Scene("basketball", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
+    ball = scene.add(Sphere("ball", SphereParams(b.radius, b.mass, b.shell, b.dt),
+                            position=b.position, velocity=b.velocity, angular_velocity=b.spin))
+    net = scene.add(basketball_net(net_p))
+    if params.settle:
+        net.settle()
+    floor = scene.add(StaticPlane("floor", height=0.0))
+    field_ = DampingField(net.x, net.segments(), params.field, thickness=net_p.cord_radius)
+    contact = replace(params.contact, thickness=net_p.cord_radius)
+    scene.connect(SphereCordContact("ball-net", ball, net, contact, mode=coupling,
+                                    standin=field_))
+    scene.connect(SpherePlaneContact("ball-floor", ball, floor, params.floor))
+    scene.primary = ball
+    scene.checkpoints = {"ball": CHECKPOINTS}
+    scene.meta = {"rim_center": (0.0, 0.0, net_p.rim_height), "rim_radius": net_p.rim_radius}
+    return scene

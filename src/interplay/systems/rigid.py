@@ -1,0 +1,118 @@
+"""Free rigid bodies: the basketball, floating balls (SPEC 2.3)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, require_positive
+import math
+
+from ..kernels.rigid import generalized, kinetic_energy, quat_mul, rigid_step
+from .base import GRAVITY, System
+
+
+@dataclass(frozen=True)
+class SphereParams:
+    """A sphere. radius in m, mass in kg; shell=True is a hollow shell (a basketball)."""
+    radius: float = 0.12  # m
+    mass: float = 0.68  # kg
+    shell: bool = True
+    dt: float = 1e-3  # s, largest integrator step
+
+
+class RigidBody(System):
+    """A free rigid body with linear and angular velocity under gravity.
+
+    State: position x (m), velocity v (m/s), orientation q (unit quaternion w,x,y,z), angular
+    velocity w (rad/s, world frame). Forces and torques about the centre of mass accumulate
+    through ``add_wrench`` and are held constant over a step.
+    """
+
+    kind = "rigid"
+    integrator = "exact-ballistic (x += hv + h^2 a/2) with exponential-map rotation"
+
+    def __init__(self, name, mass, inertia_body, dt, position=(0, 0, 0), velocity=(0, 0, 0),
+                 angular_velocity=(0, 0, 0), gravity=GRAVITY):
+        super().__init__(name, dt)
+        self._mass = require_positive(name, "mass", mass, "kg")
+        self.inertia_body = np.asarray(inertia_body, dtype=float).reshape(3)
+        if not np.all(self.inertia_body > 0):
+            raise ParameterError(f"{name}: inertia must be positive, got {self.inertia_body}")
+        self.x = np.array(position, dtype=float).reshape(3)
+        self.v = np.array(velocity, dtype=float).reshape(3)
+        self.q = np.array([1.0, 0.0, 0.0, 0.0])
+        self.w = np.array(angular_velocity, dtype=float).reshape(3)
+        self.gravity = np.array(gravity, dtype=float).reshape(3)
+        self.force = np.zeros(3)
+        self.torque = np.zeros(3)
+        self._gx, self._gv = np.zeros(7), np.zeros(7)
+
+    @property
+    def mass(self) -> float:
+        return self._mass
+
+    def clear_forces(self):
+        self.force[:] = 0.0
+        self.torque[:] = 0.0
+
+    def add_wrench(self, force, torque=None, point=None):
+        """Add a force (N) at a world point (m; default the centre) and an extra torque (N m)."""
+        f = np.asarray(force, dtype=float)
+        self.force += f
+        if point is not None:
+            self.torque += np.cross(np.asarray(point, dtype=float) - self.x, f)
+        if torque is not None:
+            self.torque += torque
+
+    def step(self, h):
+        rigid_step(self.x, self.v, self.q, self.w, self.force, self.torque, self.gravity,
+                   self._mass, self.inertia_body, h)
+
+    def kinetic_energy(self):
+        return kinetic_energy(self.v, self.q, self.w, self._mass, self.inertia_body)
+
+    def health(self):
+        if not math.isfinite(self.x.sum() + self.v.sum() + self.w.sum() + self.q.sum()):
+            return [f"{self.name}: state became non-finite at t={self.time:.4f} s"]
+        return []
+
+    def momentum(self):
+        return self._mass * self.v.copy()
+
+    def generalized_state(self):
+        """(position, quaternion) and their rates; buffers are reused: copy to keep them."""
+        generalized(self.x, self.v, self.q, self.w, self._gx, self._gv)
+        return self._gx, self._gv
+
+    def set_generalized_state(self, x, xdot):
+        self.x[:] = x[:3]
+        self.v[:] = xdot[:3]
+        q = np.asarray(x[3:7], dtype=float)
+        self.q[:] = q / np.linalg.norm(q)
+        conj = self.q * np.array([1.0, -1.0, -1.0, -1.0])
+        self.w[:] = 2.0 * quat_mul(np.asarray(xdot[3:7], dtype=float), conj)[1:]
+
+    def frame(self):
+        return {"position": self.x.copy(), "orientation": self.q.copy()}
+
+
+class Sphere(RigidBody):
+    """A solid sphere (I = 2/5 m r^2) or a thin shell (I = 2/3 m r^2, a basketball)."""
+
+    def __init__(self, name, params: SphereParams = SphereParams(), **state):
+        r = require_positive(name, "radius", params.radius, "m")
+        m = require_positive(name, "mass", params.mass, "kg")
+        c = 2.0 / 3.0 if params.shell else 2.0 / 5.0
+        super().__init__(name, m, [c * m * r * r] * 3, params.dt, **state)
+        self.radius = r
+        self.params = params
+
+    def lowest_z(self) -> float:
+        """Height (m) of the sphere's lowest point."""
+        return float(self.x[2] - self.radius)
+
+    def surface(self, subdivisions: int = 2):
+        from ..geometry.sphere import icosphere
+        verts, tris = icosphere(subdivisions)
+        return verts * self.radius, tris
