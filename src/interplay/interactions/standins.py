@@ -18,7 +18,7 @@ class DampingFieldParams:
     rest-shape cords the ball penetrates of (penetration depth / ball radius). The defaults are
     fitted to the default two-way basketball (``interplay fit-standin basketball``).
     """
-    linear: float = 0.1997  # fitted: `interplay fit-standin basketball` (docs/coupling.md)
+    linear: float = 0.2062  # fitted: `interplay fit-standin basketball` (docs/coupling.md)
     angular: float = 0.0  # the default ball enters without spin; a field cannot create spin
     enabled: bool = True
 

@@ -34,7 +34,7 @@ def _far(c, reach, x, ia, ib):
 
 @njit(cache=True)
 def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg, thickness,
-                    cs, cd, mu, eps, constraint, out_idx, out_f, out_dfdx, out_dfdv, out_vref,
+                    cs, cd, mu, eps, constraint, dt, out_idx, out_f, out_dfdx, out_dfdv, out_vref,
                     ball_wrench):
     """Contacts of a sphere (centre c, velocity vc, angular velocity w) with segments of points.
 
@@ -42,6 +42,10 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
     closest-point weights) with their 3x3 Jacobians for implicit integrators and the velocity of
     the ball's surface at the contact (what the penetration is relative to) into out_*,
     and the total force (0:3) and torque about the centre (3:6) on the ball into ball_wrench.
+    dt (s) is the step the forces will be held for: friction is capped at the force that stops
+    the tangential slip within that step (m_eff |v_t| / dt), because the regularized law's
+    viscous range (mu f_n / eps per m/s on a net knot of a fraction of a gram) would otherwise
+    make explicit steps chatter. dt <= 0 disables the cap.
     Returns the number of point entries written (2 per touching segment).
     """
     for q in range(6):
@@ -72,11 +76,11 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         fn = cs * pen - cd * vn
         wa = 1.0 - t
         wb = t
+        inv_m = 1.0 / ball_mass + wa * wa / m[ia] + wb * wb / m[ib]
         if constraint:
             arel = ball_acc - (wa * pt_acc[ia] + wb * pt_acc[ib])
             an = arel[0] * n[0] + arel[1] * n[1] + arel[2] * n[2]
             if an < 0.0:
-                inv_m = 1.0 / ball_mass + wa * wa / m[ia] + wb * wb / m[ib]
                 fn += -an / inv_m
         if fn <= 0.0:
             continue
@@ -86,7 +90,10 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         slip = 1.0
         if vtn > 0.0:
             slip = min(1.0, vtn / eps)
-            ft = (-mu * fn * slip / vtn) * vt
+            fmag = mu * fn * slip
+            if dt > 0.0:
+                fmag = min(fmag, vtn / (inv_m * dt))
+            ft = (-fmag / vtn) * vt
         F = fn * n + ft
         tau = np.cross(r, F)
         for q in range(3):
@@ -95,6 +102,8 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         # Jacobians of the point forces: penalty along n; damping along n; friction in the
         # tangent plane while it is in its viscous (regularized) range.
         visc = mu * fn / eps if vtn < eps else 0.0
+        if dt > 0.0:
+            visc = min(visc, 1.0 / (inv_m * dt))
         for side in range(2):
             p = ia if side == 0 else ib
             wgt = wa if side == 0 else wb

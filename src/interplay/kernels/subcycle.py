@@ -15,7 +15,7 @@ from .contact import sphere_segments
 from .springs import implicit_step, network_forces
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=True)
 def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k,
                          a_c, alpha, gravity, fext, kext, dext, kvref, f, h, nsub, implicit,
                          theta, tol, max_iter, seg, centres, velocities, spins, radii, masses,
@@ -51,14 +51,6 @@ def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx,
         tau = step * dt
         network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
                        alpha, gravity, fext, f)
-        for i in range(n):
-            for r in range(3):
-                acc[i, r] = f[i, r] / m[i]
-        if implicit:
-            fe[:] = fext
-            ke[:] = kext
-            de[:] = dext
-            kv[:] = kvref
         for r in range(3):
             lo[r] = x[0, r]
             hi[r] = x[0, r]
@@ -66,6 +58,12 @@ def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx,
             for r in range(3):
                 lo[r] = min(lo[r], x[i, r])
                 hi[r] = max(hi[r], x[i, r])
+        if implicit:
+            fe[:] = fext
+            ke[:] = kext
+            de[:] = dext
+            kv[:] = kvref
+        have_acc = False
         for q in range(centres.shape[0]):
             far = False
             for r in range(3):
@@ -75,10 +73,16 @@ def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx,
                     far = True
             if far:  # the sphere misses the network's bounding box
                 continue
+            if not have_acc:  # free accelerations, for the contacts' constraint term
+                for i in range(n):
+                    for r in range(3):
+                        acc[i, r] = f[i, r] / m[i]
+                have_acc = True
             vq = velocities[q] + accels[q] * tau
             cnt = sphere_segments(c, vq, spins[q], radii[q], masses[q], accels[q], x, v, m, acc,
                                   seg, params[q, 0], params[q, 1], params[q, 2], params[q, 3],
-                                  params[q, 4], params[q, 5] > 0.5, out_idx, out_f, out_dfdx,
+                                  params[q, 4], params[q, 5] > 0.5, -1.0 if implicit else dt,
+                                  out_idx, out_f, out_dfdx,
                                   out_dfdv, out_vref, wrench)
             for r in range(6):
                 impulses[q, r] += wrench[r] * dt

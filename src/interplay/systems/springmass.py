@@ -40,7 +40,9 @@ class Springs:
         """
         pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
         rest = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
-        return Springs(pairs[:, 0].copy(), pairs[:, 1].copy(), rest, stress_strain / rest,
+        with np.errstate(divide="ignore"):  # zero lengths are reported by SpringNetwork
+            k = stress_strain / rest
+        return Springs(pairs[:, 0].copy(), pairs[:, 1].copy(), rest, k,
                        np.full(len(pairs), bool(tension_only)))
 
     @staticmethod

@@ -1,0 +1,102 @@
+"""The basketball through a net: the paper's Figure 2 and Table I row, in all three modes."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from interplay.fitting import fit_standin
+from interplay.scenes import basketball as B
+
+CHECK = B.CHECKPOINTS
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return {mode: B.build(mode).simulate() for mode in ("two-way", "one-way", "hybrid")}
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """The explicit net at the paper's 1e-5 s, in strict lock step with the ball."""
+    p = dataclasses.replace(B.PARAMS(), coupling_dt=1e-5)
+    return B.build("two-way", dt=1e-5, params=p).simulate()
+
+
+def speed(result, t):
+    return np.linalg.norm(result.state_at("ball", t)[1][:3])
+
+
+def free_speed(t):
+    v0 = np.array(B.PARAMS().ball.velocity)
+    return np.linalg.norm(v0 + np.array([0, 0, -9.81]) * t)
+
+
+def test_two_way_ball_slows_in_the_net(runs):
+    r = runs["two-way"]
+    assert speed(r, B.FIT_TIME) < 0.9 * free_speed(B.FIT_TIME)
+
+
+def test_table_one_row_is_reproduced_in_magnitude(runs):
+    # paper: max 59.9 N, mean over contact 15.7 N on the 0.68 kg ball
+    s = next(s for s in runs["two-way"].interaction_stats() if s["name"] == "ball-net")
+    assert 30.0 <= s["force_N"]["max"] <= 120.0
+    assert 8.0 <= s["force_N"]["mean"] <= 32.0
+    assert s["acceleration_m_s2"]["mean"] == pytest.approx(s["force_N"]["mean"] / 0.68)
+
+
+def test_one_way_strains_the_net_more(runs):
+    strain = {m: r.diagnostics()["net"]["max_strain"] for m, r in runs.items()}
+    assert strain["one-way"] > strain["two-way"]
+
+
+def test_default_hybrid_field_matches_two_way_exit_speed(runs):
+    # the default field coefficients were fitted to this two-way run
+    assert speed(runs["hybrid"], B.FIT_TIME) == pytest.approx(speed(runs["two-way"], B.FIT_TIME),
+                                                               rel=0.10)
+
+
+def test_hybrid_primary_pass_is_the_cheap_part(runs):
+    r = runs["hybrid"]
+    assert r.passes[0].live[0].name == "ball" and r.passes[0].steps == 1500
+
+
+def test_subcycled_default_follows_the_lock_step_reference(runs, reference):
+    # the net sub-cycles the contact at 1e-5 s inside 1e-3 s coupling steps; the reference
+    # runs net and ball in lock step at 1e-5 s. The ball's predicted path inside a step is
+    # off by the change of its own acceleration, ~ (100 m/s^2) h^2 / 2 = 0.05 mm per step,
+    # and the contact is chaotic (stick-slip on the cords), so allow the issue's 1 cm.
+    for t in CHECK:
+        d = np.linalg.norm(runs["two-way"].state_at("ball", t)[0][:3]
+                           - reference.state_at("ball", t)[0][:3])
+        assert d < 0.01, f"t={t}: {d:.4f} m from the reference"
+
+
+@pytest.mark.xfail(strict=True, reason="backward Euler's numerical damping at 1e-3 s makes the "
+                   "0.8 g net far too viscous against a 5 m/s ball (measured 7-9 cm off, or "
+                   "unstable); see the closing note of issue 2")
+def test_implicit_net_at_1ms_follows_the_reference(reference):
+    r = B.build("two-way", integrator="implicit", dt=1e-3,
+                params=dataclasses.replace(B.PARAMS(), coupling_dt=1e-3)).simulate(
+                    refine_unstable=False)
+    for t in CHECK:
+        d = np.linalg.norm(r.state_at("ball", t)[0][:3] - reference.state_at("ball", t)[0][:3])
+        assert d < 0.01
+
+
+def test_fit_standin_reproduces_the_default(runs):
+    fit = fit_standin(B, reference=runs["two-way"])
+    assert fit["speed_error_rel"] < 1e-3
+    assert fit["linear"] == pytest.approx(B.PARAMS().field.linear, rel=0.02)
+
+
+def test_checkpoints_and_summary(runs):
+    s = runs["two-way"].summary()
+    times = [c["t"] for c in s["primary_checkpoints"]]
+    assert times == CHECK
+    # before the net (t = 0.2 s) the ball is in free flight: closed form
+    c = s["primary_checkpoints"][0]
+    x0, v0 = np.array(B.PARAMS().ball.position), np.array(B.PARAMS().ball.velocity)
+    g = np.array([0, 0, -9.81])
+    np.testing.assert_allclose(c["position"], x0 + v0 * 0.2 + 0.5 * g * 0.04, atol=1e-9)
+    assert s["advice"]["mode"] == "two-way"
+    assert s["diagnostics"]["net"]["instability"] == []

@@ -1,0 +1,142 @@
+"""Spring-mass networks: closed-form oscillation, damping rates, energy, the elastic catenary."""
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from interplay.errors import ParameterError, StabilityError
+from interplay.systems.springmass import SpringNetwork, Springs
+
+
+def oscillator(k=100.0, m=0.5, integrator="explicit", dt=1e-4, alpha=0.0, beta=0.0, x0=0.01):
+    """One free point on a spring to a fixed point, no gravity, displaced by x0 along x."""
+    x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    springs = Springs.from_ratio(x, [(0, 1)], k * 1.0)  # k = ratio / l0 with l0 = 1 m
+    net = SpringNetwork("osc", x, [1.0, m], springs, dt=dt, integrator=integrator,
+                        mass_damping=alpha, stiffness_damping=beta, fixed=[0],
+                        gravity=(0, 0, 0))
+    net.x[1, 0] += x0
+    return net
+
+
+def run(net, seconds, h):
+    xs, ts = [], []
+    for i in range(int(round(seconds / h))):
+        net.clear_forces()
+        net.advance(h)
+        xs.append(net.x[1, 0] - 1.0)
+        ts.append((i + 1) * h)
+    return np.array(ts), np.array(xs)
+
+
+def period(ts, xs):
+    """Mean period from upward zero crossings (linear interpolation between samples)."""
+    i = np.flatnonzero((xs[:-1] < 0) & (xs[1:] >= 0))
+    tc = ts[i] - xs[i] * (ts[i + 1] - ts[i]) / (xs[i + 1] - xs[i])
+    return np.mean(np.diff(tc))
+
+
+@pytest.mark.parametrize("integrator", ["explicit", "implicit"])
+def test_mass_on_spring_period(integrator):
+    k, m = 100.0, 0.5
+    T = 2 * np.pi * np.sqrt(m / k)
+    h = T / 2000
+    net = oscillator(k, m, integrator, dt=h)
+    ts, xs = run(net, 5 * T, h)
+    # phase error of symplectic and backward Euler is O((w h)^2) = (2 pi / 2000)^2 ~ 1e-5;
+    # the crossing interpolation adds O(h^2 / T^2): 1e-4 relative is a safe bound for both.
+    assert period(ts, xs) == pytest.approx(T, rel=1e-4)
+
+
+def test_energy_conserved_without_damping():
+    k, m = 100.0, 0.5
+    T = 2 * np.pi * np.sqrt(m / k)
+    h = T / 1000
+    net = oscillator(k, m, "explicit", dt=h)
+    ts, xs = run(net, 10 * T, h)
+    e0 = 0.5 * k * 0.01 ** 2
+    e = net.kinetic_energy() + 0.5 * k * (net.x[1, 0] - 1.0) ** 2
+    # symplectic Euler conserves a shadow energy: the true energy oscillates by O(w h) ~ 0.6%
+    assert e == pytest.approx(e0, rel=1e-2)
+    assert np.max(np.abs(xs)) == pytest.approx(0.01, rel=1e-2)
+
+
+def test_mass_proportional_damping_rate():
+    # f = -alpha m v: amplitude decays as exp(-alpha t / 2)
+    k, m, alpha = 100.0, 0.5, 0.4
+    T = 2 * np.pi * np.sqrt(m / k)
+    h = T / 2000
+    ts, xs = run(oscillator(k, m, "explicit", dt=h, alpha=alpha), 20 * T, h)
+    peaks = [np.max(np.abs(xs[(ts >= a) & (ts < a + T)])) for a in (0.0, 19 * T)]
+    rate = np.log(peaks[0] / peaks[1]) / (19 * T)
+    # the envelope rate is exact to O(zeta^2) = (alpha / 2w)^2 ~ 2e-4 and peak sampling to O(h)
+    assert rate == pytest.approx(alpha / 2, rel=1e-2)
+
+
+def test_stiffness_proportional_damping_rate():
+    # kd = beta k along the spring: zeta w = beta k / (2 m), amplitude ~ exp(-beta k t / 2m)
+    k, m, beta = 100.0, 0.5, 2e-3
+    T = 2 * np.pi * np.sqrt(m / k)
+    h = T / 2000
+    ts, xs = run(oscillator(k, m, "explicit", dt=h, beta=beta), 20 * T, h)
+    peaks = [np.max(np.abs(xs[(ts >= a) & (ts < a + T)])) for a in (0.0, 19 * T)]
+    rate = np.log(peaks[0] / peaks[1]) / (19 * T)
+    assert rate == pytest.approx(beta * k / (2 * m), rel=1e-2)
+
+
+def elastic_catenary(span, L0, w, EA, s):
+    """Irvine's elastic catenary between supports at equal height, by unstretched arc length s.
+
+    w: weight per unstretched length (N/m); returns (x(s), z(s)) with the left support at 0.
+    The horizontal tension H is found with a root finder so that x(L0) = span.
+    """
+    V = w * L0 / 2
+
+    def x_of(H, s):
+        return H * s / EA + H / w * (np.arcsinh(V / H) - np.arcsinh((V - w * s) / H))
+
+    H = brentq(lambda H: x_of(H, L0) - span, 1e-6, 1e6)
+    z = (w * s / EA) * (V / w - s / 2) + H / w * (np.sqrt(1 + (V / H) ** 2)
+                                                  - np.sqrt(1 + ((V - w * s) / H) ** 2))
+    return x_of(H, s), -z
+
+
+def test_chain_rests_on_the_elastic_catenary():
+    N, span, L0, rho, EA = 40, 1.0, 1.3, 0.2, 50.0  # springs, m, m, kg/m, N
+    g = 9.81
+    s = np.linspace(0, L0, N + 1)
+    # start on a parabola-ish sag so the springs begin near their rest lengths
+    x0 = np.stack([s * span / L0, 0 * s, -0.3 * np.sin(np.pi * s / L0)], axis=1)
+    pairs = [(i, i + 1) for i in range(N)]
+    springs = Springs.from_ratio(x0, pairs, EA)
+    springs = Springs(springs.i, springs.j, np.full(N, L0 / N), np.full(N, EA / (L0 / N)),
+                      springs.tension_only)
+    m = np.full(N + 1, rho * L0 / N)
+    m[[0, -1]] /= 2
+    net = SpringNetwork("chain", x0, m, springs, integrator="implicit", dt=1e-3, fixed=[0, N])
+    net.settle(seconds=30.0, h=5e-3, damping=5.0)
+    xc, zc = elastic_catenary(span, L0, rho * g, EA, s)
+    sag = -zc.min()
+    # lumping the weight at N nodes changes the shape by O((L0/N)^2 / L0^2) ~ 1e-3 of the sag
+    np.testing.assert_allclose(net.x[:, 2], zc, atol=2e-3 * sag)
+    np.testing.assert_allclose(net.x[:, 0], xc, atol=2e-3 * sag)
+
+
+def test_explicit_step_above_bound_is_refused():
+    with pytest.raises(StabilityError, match=r"explicit stability bound .* --integrator implicit"):
+        oscillator(k=1e6, m=1e-3, integrator="explicit", dt=1e-3)
+
+
+def test_bad_network_input():
+    x = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    sp = Springs.from_ratio(x, [(0, 1)], 10.0)
+    with pytest.raises(ParameterError, match="mass of point 1"):
+        SpringNetwork("n", x, [1.0, -2.0], sp)
+    with pytest.raises(ParameterError, match="point 0 is not finite"):
+        SpringNetwork("n", np.array([[np.nan, 0, 0], [1, 0, 0]]), 1.0, sp)
+    with pytest.raises(ParameterError, match="zero rest length"):
+        SpringNetwork("n", np.array([[0.0, 0, 0], [0, 0, 0]]), 1.0,
+                      Springs.from_ratio(np.zeros((2, 3)), [(0, 1)], 10.0))
+    with pytest.raises(ParameterError, match="non-positive stiffness"):
+        SpringNetwork("n", x, 1.0, Springs.from_ratio(x, [(0, 1)], 0.0))
+    with pytest.raises(ParameterError, match="unknown integrator"):
+        SpringNetwork("n", x, 1.0, sp, integrator="rk4")
