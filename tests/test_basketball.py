@@ -71,9 +71,9 @@ def test_subcycled_default_follows_the_lock_step_reference(runs, reference):
         assert d < 0.01, f"t={t}: {d:.4f} m from the reference"
 
 
-@pytest.mark.xfail(strict=True, reason="backward Euler's numerical damping at 1e-3 s makes the "
-                   "0.8 g net far too viscous against a 5 m/s ball (measured 7-9 cm off, or "
-                   "unstable); see the closing note of issue 2")
+@pytest.mark.xfail(strict=True, reason="the implicit net converges only to first order in the "
+                   "contact: measured 22 cm off at 1e-3 s (BDF2; 34 cm backward Euler), 8 cm at "
+                   "2e-4 s; see docs/coupling.md and the closing note of issue 2")
 def test_implicit_net_at_1ms_follows_the_reference(reference):
     r = B.build("two-way", integrator="implicit", dt=1e-3,
                 params=dataclasses.replace(B.PARAMS(), coupling_dt=1e-3)).simulate(

@@ -48,10 +48,10 @@ def test_network_forces_match_numpy():
                                rtol=1e-12, atol=1e-12)
 
 
-def dense_implicit(x, v, m, fixed, si, sj, l0, k, kd, tonly, alpha, g, fext, kext, dext, h, th):
-    """Assemble (M - th h D - th^2 h^2 K) dv = h (f + th h K v) densely and solve it."""
+def dense_jacobians(x, v, m, si, sj, l0, k, kd, tonly, alpha, g, fext, kext, dext):
+    """Force f (3n,), stiffness K = df/dx and damping D = df/dv (3n, 3n), assembled densely."""
     n = len(x)
-    f = numpy_forces(x, v, m, si, sj, l0, k, kd, tonly, alpha, g, fext)
+    f = numpy_forces(x, v, m, si, sj, l0, k, kd, tonly, alpha, g, fext).ravel()
     Kd = np.zeros((3 * n, 3 * n))
     Dd = np.zeros((3 * n, 3 * n))
     for i in range(n):
@@ -69,12 +69,15 @@ def dense_implicit(x, v, m, fixed, si, sj, l0, k, kd, tonly, alpha, g, fext, kex
         for (p, q, sign) in ((a, a, 1), (b, b, 1), (a, b, -1), (b, a, -1)):
             Kd[3 * p:3 * p + 3, 3 * q:3 * q + 3] += sign * blk
             Dd[3 * p:3 * p + 3, 3 * q:3 * q + 3] += sign * dblk
-    A = np.diag(np.repeat(m, 3)) - th * h * Dd - th * th * h * h * Kd
-    rhs = h * (f.ravel() + th * h * Kd @ v.ravel())
+    return f, Kd, Dd
+
+
+def solve_free(A, rhs, fixed):
+    """Solve A dv = rhs on the free points; fixed points get dv = 0."""
     free = np.repeat(~fixed, 3)
-    dv = np.zeros(3 * n)
+    dv = np.zeros(len(rhs))
     dv[free] = np.linalg.solve(A[np.ix_(free, free)], rhs[free])
-    return dv.reshape(n, 3)
+    return dv.reshape(-1, 3)
 
 
 @pytest.mark.parametrize("theta", [1.0, 0.5])
@@ -94,15 +97,45 @@ def test_implicit_step_matches_dense_solve(theta):
     dext[3] = -2.0 * np.outer(nrm, nrm)
     g = np.array([0, 0, -9.81])
     h = 1e-2
-    dv_ref = dense_implicit(x, v, m, fixed, si, sj, l0, k, kd, tonly, 0.2, g, fext, kext, dext,
-                            h, theta)
+    f, Kd, Dd = dense_jacobians(x, v, m, si, sj, l0, k, kd, tonly, 0.2, g, fext, kext, dext)
+    A = np.diag(np.repeat(m, 3)) - theta * h * Dd - (theta * h) ** 2 * Kd
+    dv_ref = solve_free(A, h * (f + theta * h * Kd @ v.ravel()), fixed)
     x1, v1 = x.copy(), v.copy()
     K.implicit_step(x1, v1, m, fixed, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.2, g, fext, kext,
-                    dext, np.zeros_like(x), np.zeros_like(x), h, theta, 1e-12, 500)
+                    dext, np.zeros_like(x), np.zeros_like(x), h, theta, False, False,
+                    np.zeros_like(x), np.zeros_like(x), 1e-12, 500)
     # CG to a 1e-12 relative residual: dv agrees to ~1e-10 relative to its size
     np.testing.assert_allclose(v1 - v, dv_ref, atol=1e-9 * np.abs(dv_ref).max())
     np.testing.assert_allclose(x1, x + h * (v + theta * dv_ref), atol=1e-9)
     assert np.all(x1[fixed] == x[fixed])
+
+
+def test_bdf2_step_matches_dense_solve():
+    # BDF2 is the theta-type system with hs = 2h/3 and a right-hand side that remembers the
+    # previous step: M (v - vp) / 3 + hs (f + K y), y = (x - xp) / 3 + hs v
+    x, v, m, si, sj, l0, k, kd, tonly = random_network(seed=5)
+    n = len(x)
+    fixed = np.zeros(n, dtype=bool)
+    g = np.array([0, 0, -9.81])
+    z3, z33 = np.zeros((n, 3)), np.zeros((n, 3, 3))
+    h = 5e-3
+    xp, vp = np.zeros_like(x), np.zeros_like(x)
+    x1, v1 = x.copy(), v.copy()
+    K.implicit_step(x1, v1, m, fixed, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.0, g, z3, z33, z33,
+                    z3, np.zeros_like(x), h, 1.0, True, False, xp, vp, 1e-13, 500)
+    np.testing.assert_array_equal(xp, x)  # the first step is backward Euler and records x, v
+    # the dense BDF2 step from (x1, v1) with previous state (x, v)
+    hs = 2 * h / 3
+    f, Kd, Dd = dense_jacobians(x1, v1, m, si, sj, l0, k, kd, tonly, 0.0, g, z3, z33, z33)
+    A = np.diag(np.repeat(m, 3)) - hs * Dd - hs * hs * Kd
+    y = ((x1 - x) / 3 + hs * v1).ravel()
+    rhs = np.repeat(m, 3) * (v1 - v).ravel() / 3 + hs * (f + Kd @ y)
+    dv_ref = solve_free(A, rhs, fixed)
+    x2, v2 = x1.copy(), v1.copy()
+    K.implicit_step(x2, v2, m, fixed, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.0, g, z3, z33, z33,
+                    z3, np.zeros_like(x), h, 1.0, True, True, xp, vp, 1e-13, 500)
+    np.testing.assert_allclose(v2 - v1, dv_ref, atol=1e-8 * np.abs(dv_ref).max())
+    np.testing.assert_allclose(x2, x1 + (x1 - x) / 3 + hs * (v1 + dv_ref), atol=1e-10)
 
 
 def brute_closest(c, a, b, samples=200001):
@@ -168,7 +201,7 @@ def test_subcycled_contact_conserves_momentum():
         substep_with_spheres(x, v, m, np.zeros(n, bool), pairs[:, 0].copy(), pairs[:, 1].copy(),
                              l0, k, 2e-4 * k, np.ones(len(l0), bool), *NO_ANCHORS, 0.0,
                              np.zeros(3), z3, z33, z33, z3, np.zeros_like(x), 1e-3, 20, False,
-                             1.0, 1e-8, 100, pairs, centres, vel, np.zeros((1, 3)),
+                             1.0, False, False, z3, z3, 1e-8, 100, pairs, centres, vel, np.zeros((1, 3)),
                              np.array([0.12]), np.array([0.68]), np.zeros((1, 3)), params, imp)
         total += imp[0, :3]
         centres += vel * 1e-3

@@ -7,13 +7,14 @@ from interplay.errors import ParameterError, StabilityError
 from interplay.systems.springmass import SpringNetwork, Springs
 
 
-def oscillator(k=100.0, m=0.5, integrator="explicit", dt=1e-4, alpha=0.0, beta=0.0, x0=0.01):
+def oscillator(k=100.0, m=0.5, integrator="explicit", dt=1e-4, alpha=0.0, beta=0.0, x0=0.01,
+               scheme="theta"):
     """One free point on a spring to a fixed point, no gravity, displaced by x0 along x."""
     x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     springs = Springs.from_ratio(x, [(0, 1)], k * 1.0)  # k = ratio / l0 with l0 = 1 m
     net = SpringNetwork("osc", x, [1.0, m], springs, dt=dt, integrator=integrator,
                         mass_damping=alpha, stiffness_damping=beta, fixed=[0],
-                        gravity=(0, 0, 0))
+                        gravity=(0, 0, 0), scheme=scheme)
     net.x[1, 0] += x0
     return net
 
@@ -45,6 +46,23 @@ def test_mass_on_spring_period(integrator):
     # phase error of symplectic and backward Euler is O((w h)^2) = (2 pi / 2000)^2 ~ 1e-5;
     # the crossing interpolation adds O(h^2 / T^2): 1e-4 relative is a safe bound for both.
     assert period(ts, xs) == pytest.approx(T, rel=1e-4)
+
+
+def test_bdf2_keeps_the_amplitude_backward_euler_damps():
+    # per step, backward Euler multiplies a mode's amplitude by ~1 - (w h)^2 / 2 and BDF2 by
+    # ~1 - (w h)^4 / 4: at w h = 2 pi / 1000 over 4 periods (4000 steps) that is a 7.6% loss
+    # for backward Euler and ~1e-6 for BDF2
+    k, m = 100.0, 0.5
+    T = 2 * np.pi * np.sqrt(m / k)
+    h = T / 1000
+    amp = {}
+    for scheme in ("theta", "bdf2"):
+        ts, xs = run(oscillator(k, m, "implicit", dt=h, scheme=scheme), 5 * T, h)
+        amp[scheme] = np.max(np.abs(xs[ts > 4 * T])) / 0.01
+        assert period(ts, xs) == pytest.approx(T, rel=2e-4)
+    # the largest |x| of the last period is at its start, after 4000 steps
+    assert amp["theta"] == pytest.approx(np.exp(-0.5 * (2 * np.pi / 1000) ** 2 * 4000), rel=5e-3)
+    assert amp["bdf2"] == pytest.approx(1.0, abs=2e-3)
 
 
 def test_energy_conserved_without_damping():

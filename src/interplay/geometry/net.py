@@ -17,8 +17,8 @@ class NetParams:
     knots (two knot rows make one row of diamonds); mass: kg (spread over the knots by cord length); cord_ea: the cords' stress/strain
     ratio E*A (N), so k = EA / l0 for each cord; rim_stiffness: N/m and rim_damping: N s/m of
     the springs tying the top knots to the rim; mass_damping: 1/s; stiffness_damping: s;
-    dt: s; integrator: explicit | implicit; cord_radius: m (contact skin); theta: implicit
-    blend (1 backward Euler, 1/2 trapezoidal).
+    dt: s; integrator: explicit | implicit; cord_radius: m (contact skin); scheme: the implicit
+    integrator, bdf2 or theta; theta: for the theta scheme (1 backward Euler, 1/2 trapezoidal).
     """
     rim_radius: float = 0.2286
     rim_height: float = 3.05
@@ -37,6 +37,7 @@ class NetParams:
     dt: float = 1e-5
     integrator: str = "explicit"
     cord_radius: float = 0.003
+    scheme: str = "theta"  # backward Euler (theta = 1), Baraff & Witkin; or "bdf2"
     theta: float = 1.0
 
 
@@ -84,4 +85,5 @@ def basketball_net(p: NetParams = NetParams(), name: str = "net") -> SpringNetwo
     anchors = (top, x[top].copy(), p.rim_stiffness, p.rim_damping)
     return SpringNetwork(name, x, m, cords, dt=p.dt, integrator=p.integrator,
                          mass_damping=p.mass_damping, stiffness_damping=p.stiffness_damping,
-                         anchors=anchors, theta=p.theta)
+                         anchors=anchors, scheme=p.scheme,
+                         theta=p.theta)

@@ -81,7 +81,7 @@ class SphereCordContact(Interaction):
         self._k = k = sphere_segments(ball.x, ball.v, ball.w, ball.radius, ball.mass, ball.gravity,
                             net.x, net.v, net.m, pt_acc, self.seg, p.thickness, p.stiffness,
                             p.damping, p.friction, p.eps, p.constraint,
-                            -1.0 if net.integrator == "implicit" else self._h, self._idx, self._f,
+                            self._h, self._idx, self._f,
                             self._dfdx, self._dfdv, self._vref, self._wrench)
         if k == 0:
             return self._wrench[:3], self._wrench[3:], False

@@ -18,7 +18,7 @@ from .springs import implicit_step, network_forces
 @njit(cache=True, fastmath=True)
 def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k,
                          a_c, alpha, gravity, fext, kext, dext, kvref, f, h, nsub, implicit,
-                         theta, tol, max_iter, seg, centres, velocities, spins, radii, masses,
+                         theta, bdf2, has_prev, xp, vp, tol, max_iter, seg, centres, velocities, spins, radii, masses,
                          accels, params, impulses):
     """Advance the network by h in nsub substeps with sphere contacts re-evaluated each substep.
 
@@ -81,7 +81,7 @@ def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx,
             vq = velocities[q] + accels[q] * tau
             cnt = sphere_segments(c, vq, spins[q], radii[q], masses[q], accels[q], x, v, m, acc,
                                   seg, params[q, 0], params[q, 1], params[q, 2], params[q, 3],
-                                  params[q, 4], params[q, 5] > 0.5, -1.0 if implicit else dt,
+                                  params[q, 4], params[q, 5] > 0.5, dt,
                                   out_idx, out_f, out_dfdx,
                                   out_dfdv, out_vref, wrench)
             for r in range(6):
@@ -104,7 +104,8 @@ def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx,
                     kv[p, a] += s_
         if implicit:
             implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k,
-                          a_c, alpha, gravity, fe, ke, de, kv, f, dt, theta, tol, max_iter)
+                          a_c, alpha, gravity, fe, ke, de, kv, f, dt, theta, bdf2,
+                          has_prev or step > 0, xp, vp, tol, max_iter)
         else:
             # symplectic Euler on the forces already evaluated (internal, held, contacts)
             for i in range(n):

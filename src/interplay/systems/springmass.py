@@ -18,6 +18,7 @@ from ..kernels.subcycle import substep_with_spheres
 from .base import GRAVITY, System
 
 INTEGRATORS = ("explicit", "implicit")
+SCHEMES = ("bdf2", "theta")
 
 
 @dataclass(frozen=True)
@@ -58,8 +59,9 @@ class SpringNetwork(System):
     mass_damping: alpha (1/s), force -alpha m_i v_i; stiffness_damping: beta (s), kd = beta k;
     anchors: (indices, world positions (a,3) m, stiffness N/m, damping N s/m) zero-length springs;
     fixed: indices of points that never move; strain_limit: a strain above which the state is
-    reported unstable; theta: implicit blend, 1 = backward Euler, 1/2 = trapezoidal (less
-    numerical damping).
+    reported unstable; scheme: the implicit integrator, "bdf2" (second order, little numerical
+    damping of resolved motion) or "theta" (theta-method: theta = 1 backward Euler, 1/2
+    trapezoidal).
     """
 
     kind = "springmass"
@@ -67,7 +69,7 @@ class SpringNetwork(System):
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
-                 theta=1.0):
+                 scheme="theta", theta=1.0):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -105,6 +107,12 @@ class SpringNetwork(System):
         self.gravity = np.array(gravity, dtype=float)
         self.strain_limit = require_positive(name, "strain_limit", strain_limit)
         self.cg_tolerance, self.cg_max_iter = cg_tolerance, cg_max_iter
+        if scheme not in SCHEMES:
+            raise ParameterError(f"{name}: unknown implicit scheme {scheme!r}; choose one of "
+                                 f"{', '.join(SCHEMES)}")
+        self.scheme = scheme
+        self.xp, self.vp = np.zeros_like(x), np.zeros_like(x)
+        self.has_prev = False  # BDF2 needs the previous step's state
         if not 0.5 <= theta <= 1.0:
             raise ParameterError(f"{name}: theta must be in [0.5, 1] (1 = backward Euler), "
                                  f"got {theta}")
@@ -207,8 +215,10 @@ class SpringNetwork(System):
             self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
             self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha,
             self.gravity, self.fext, self.kext, self.dext, self.kvref, self._f, h, n,
-            self.integrator == "implicit", self.theta, self.cg_tolerance, self.cg_max_iter,
+            self.integrator == "implicit", self.theta, self.scheme == "bdf2", self.has_prev,
+            self.xp, self.vp, self.cg_tolerance, self.cg_max_iter,
             self._seg, arr[0], arr[1], arr[2], arr[4], arr[5], arr[3], arr[6], self.impulses)
+        self.has_prev = self.scheme == "bdf2"
         self.time += h
 
     def internal_forces(self) -> np.ndarray:
@@ -227,8 +237,10 @@ class SpringNetwork(System):
             self.cg_iterations = K.implicit_step(
                 self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
                 self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha,
-                self.gravity, self.fext, self.kext, self.dext, self.kvref, self._f, h, self.theta, self.cg_tolerance,
+                self.gravity, self.fext, self.kext, self.dext, self.kvref, self._f, h, self.theta,
+                self.scheme == "bdf2", self.has_prev, self.xp, self.vp, self.cg_tolerance,
                 self.cg_max_iter)
+            self.has_prev = self.scheme == "bdf2"
 
     def advance(self, h):
         # Explicit substeps with held forces run inside one kernel call (no Python per substep).
@@ -254,11 +266,13 @@ class SpringNetwork(System):
                 K.implicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0,
                                 self.k, self.kd, self.tension_only, self.a_idx, self.a_pos,
                                 self.a_k, self.a_c, self.alpha, self.gravity, self.fext, self.kext,
-                                self.dext, self.kvref, self._f, h, 1.0, 1e-10, 1000)
+                                self.dext, self.kvref, self._f, h, 1.0, False, False,
+                                self.xp, self.vp, 1e-10, 1000)
         finally:
             self.alpha = alpha
             self.fext[:] = saved
         self.v[:] = 0.0
+        self.has_prev = False
 
     # --- measures --------------------------------------------------------------------------
     def strain(self) -> float:
@@ -292,6 +306,7 @@ class SpringNetwork(System):
     def set_generalized_state(self, x, xdot):
         self.x[:] = np.reshape(x, self.x.shape)
         self.v[:] = np.reshape(xdot, self.v.shape)
+        self.has_prev = False  # a jump in state: BDF2 restarts with a backward-Euler step
 
     def frame(self):
         return {"points": self.x.copy()}
