@@ -22,6 +22,17 @@ def _closest_param(cx, cy, cz, ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True, inline="always")
+def _offset_from_segment(c, x, ia, ib):
+    """(t, dx, dy, dz, d2): closest-point parameter on segment ia-ib and the offset c - q."""
+    t = _closest_param(c[0], c[1], c[2], x[ia, 0], x[ia, 1], x[ia, 2],
+                       x[ib, 0], x[ib, 1], x[ib, 2])
+    dx = c[0] - (x[ia, 0] + t * (x[ib, 0] - x[ia, 0]))
+    dy = c[1] - (x[ia, 1] + t * (x[ib, 1] - x[ia, 1]))
+    dz = c[2] - (x[ia, 2] + t * (x[ib, 2] - x[ia, 2]))
+    return t, dx, dy, dz, dx * dx + dy * dy + dz * dz
+
+
+@njit(cache=True, inline="always")
 def _far(c, reach, x, ia, ib):
     """True when the segment's bounding box misses the sphere's: a cheap early rejection."""
     for r in range(3):
@@ -57,12 +68,7 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         ib = seg[s, 1]
         if _far(c, reach, x, ia, ib):
             continue
-        t = _closest_param(c[0], c[1], c[2], x[ia, 0], x[ia, 1], x[ia, 2],
-                           x[ib, 0], x[ib, 1], x[ib, 2])
-        dx = c[0] - (x[ia, 0] + t * (x[ib, 0] - x[ia, 0]))
-        dy = c[1] - (x[ia, 1] + t * (x[ib, 1] - x[ia, 1]))
-        dz = c[2] - (x[ia, 2] + t * (x[ib, 2] - x[ia, 2]))
-        d2 = dx * dx + dy * dy + dz * dz
+        t, dx, dy, dz, d2 = _offset_from_segment(c, x, ia, ib)
         if d2 >= reach * reach or d2 <= 0.0:
             continue
         dist = np.sqrt(d2)
@@ -155,14 +161,7 @@ def sphere_segment_overlap(c, radius, x, seg, reach):
     """Sum over segments of the sphere's penetration depth into each, as a fraction of radius."""
     total = 0.0
     for s in range(seg.shape[0]):
-        ia = seg[s, 0]
-        ib = seg[s, 1]
-        t = _closest_param(c[0], c[1], c[2], x[ia, 0], x[ia, 1], x[ia, 2],
-                           x[ib, 0], x[ib, 1], x[ib, 2])
-        dx = c[0] - (x[ia, 0] + t * (x[ib, 0] - x[ia, 0]))
-        dy = c[1] - (x[ia, 1] + t * (x[ib, 1] - x[ia, 1]))
-        dz = c[2] - (x[ia, 2] + t * (x[ib, 2] - x[ia, 2]))
-        d2 = dx * dx + dy * dy + dz * dz
+        d2 = _offset_from_segment(c, x, seg[s, 0], seg[s, 1])[4]
         if d2 < reach * reach:
             total += (reach - np.sqrt(d2)) / radius
     return total

@@ -12,6 +12,15 @@ import numpy as np
 from numba import njit
 
 
+@njit(cache=True, inline="always")
+def _spring_vector(x, a, b):
+    """(d0, d1, d2, length) of x[a] - x[b]."""
+    d0 = x[a, 0] - x[b, 0]
+    d1 = x[a, 1] - x[b, 1]
+    d2 = x[a, 2] - x[b, 2]
+    return d0, d1, d2, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
 @njit(cache=True, fastmath=True)
 def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
                    alpha, gravity, fext, f):
@@ -23,10 +32,7 @@ def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, 
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
-        d0 = x[a, 0] - x[b, 0]
-        d1 = x[a, 1] - x[b, 1]
-        d2 = x[a, 2] - x[b, 2]
-        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        d0, d1, d2, ln = _spring_vector(x, a, b)
         if ln <= 0.0 or (tension_only[s] and ln < l0[s]):
             continue
         u0 = d0 / ln
@@ -46,20 +52,25 @@ def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, 
             f[p, c] += -a_k[r] * (x[p, c] - a_pos[r, c]) - a_c[r] * v[p, c]
 
 
+@njit(cache=True, inline="always")
+def symplectic_update(x, v, m, fixed, f, h):
+    """v += h f / m, then x += h v, for every free point."""
+    for p in range(x.shape[0]):
+        if fixed[p]:
+            continue
+        for c in range(3):
+            v[p, c] += h * f[p, c] / m[p]
+            x[p, c] += h * v[p, c]
+
+
 @njit(cache=True)
 def explicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
                   alpha, gravity, fext, f, h, nsteps):
     """nsteps symplectic-Euler steps of h seconds (v += h f/m, then x += h v), fext held."""
-    n = x.shape[0]
     for _ in range(nsteps):
         network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
                        alpha, gravity, fext, f)
-        for p in range(n):
-            if fixed[p]:
-                continue
-            for c in range(3):
-                v[p, c] += h * f[p, c] / m[p]
-                x[p, c] += h * v[p, c]
+        symplectic_update(x, v, m, fixed, f, h)
 
 
 @njit(cache=True)
@@ -72,10 +83,7 @@ def _spring_blocks(x, si, sj, l0, k, kd, tension_only, h, C, Kblk):
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
-        d0 = x[a, 0] - x[b, 0]
-        d1 = x[a, 1] - x[b, 1]
-        d2 = x[a, 2] - x[b, 2]
-        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        d0, d1, d2, ln = _spring_vector(x, a, b)
         for r in range(3):
             for c in range(3):
                 C[s, r, c] = 0.0
@@ -290,11 +298,7 @@ def max_strain(x, si, sj, l0):
     """Largest (l - l0) / l0 over all springs."""
     best = -1.0
     for s in range(si.shape[0]):
-        a, b = si[s], sj[s]
-        d0 = x[a, 0] - x[b, 0]
-        d1 = x[a, 1] - x[b, 1]
-        d2 = x[a, 2] - x[b, 2]
-        e = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) / l0[s] - 1.0
+        e = _spring_vector(x, si[s], sj[s])[3] / l0[s] - 1.0
         if e > best:
             best = e
     return best

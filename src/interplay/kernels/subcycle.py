@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from .contact import sphere_segments
-from .springs import implicit_step, network_forces
+from .springs import implicit_step, network_forces, symplectic_update
 
 
 @njit(cache=True, fastmath=True)
@@ -108,9 +108,4 @@ def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx,
                           has_prev or step > 0, xp, vp, tol, max_iter)
         else:
             # symplectic Euler on the forces already evaluated (internal, held, contacts)
-            for i in range(n):
-                if fixed[i]:
-                    continue
-                for r in range(3):
-                    v[i, r] += dt * f[i, r] / m[i]
-                    x[i, r] += dt * v[i, r]
+            symplectic_update(x, v, m, fixed, f, dt)
