@@ -63,6 +63,14 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         ball_wrench[q] = 0.0
     reach = radius + thickness
     k = 0
+    # scratch vectors, allocated once per call rather than per contact
+    n = np.empty(3)
+    r = np.empty(3)
+    vball = np.empty(3)
+    vrel = np.empty(3)
+    vt = np.empty(3)
+    F = np.empty(3)
+    tau = np.empty(3)
     for s in range(seg.shape[0]):
         ia = seg[s, 0]
         ib = seg[s, 1]
@@ -73,35 +81,45 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
             continue
         dist = np.sqrt(d2)
         pen = reach - dist
-        n = np.array([dx / dist, dy / dist, dz / dist])
-        r = -radius * n
-        vball = vc + np.cross(w, r)
-        vcord = (1.0 - t) * v[ia] + t * v[ib]
-        vrel = vball - vcord
-        vn = vrel[0] * n[0] + vrel[1] * n[1] + vrel[2] * n[2]
-        fn = cs * pen - cd * vn
         wa = 1.0 - t
         wb = t
+        n[0], n[1], n[2] = dx / dist, dy / dist, dz / dist
+        for q in range(3):
+            r[q] = -radius * n[q]
+        # velocity of the ball's surface at the contact (v + w x r), relative to the cord's
+        vball[0] = vc[0] + w[1] * r[2] - w[2] * r[1]
+        vball[1] = vc[1] + w[2] * r[0] - w[0] * r[2]
+        vball[2] = vc[2] + w[0] * r[1] - w[1] * r[0]
+        vn = 0.0
+        for q in range(3):
+            vrel[q] = vball[q] - (wa * v[ia, q] + wb * v[ib, q])
+            vn += vrel[q] * n[q]
+        fn = cs * pen - cd * vn
         inv_m = 1.0 / ball_mass + wa * wa / m[ia] + wb * wb / m[ib]
         if constraint:
-            arel = ball_acc - (wa * pt_acc[ia] + wb * pt_acc[ib])
-            an = arel[0] * n[0] + arel[1] * n[1] + arel[2] * n[2]
+            an = 0.0
+            for q in range(3):
+                an += (ball_acc[q] - (wa * pt_acc[ia, q] + wb * pt_acc[ib, q])) * n[q]
             if an < 0.0:
                 fn += -an / inv_m
         if fn <= 0.0:
             continue
-        vt = vrel - vn * n
-        vtn = np.sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2])
-        ft = np.zeros(3)
-        slip = 1.0
+        vtn = 0.0
+        for q in range(3):
+            vt[q] = vrel[q] - vn * n[q]
+            vtn += vt[q] * vt[q]
+        vtn = np.sqrt(vtn)
+        ft_scale = 0.0  # friction force = ft_scale * vt
         if vtn > 0.0:
-            slip = min(1.0, vtn / eps)
-            fmag = mu * fn * slip
+            fmag = mu * fn * min(1.0, vtn / eps)
             if dt > 0.0:
                 fmag = min(fmag, vtn / (inv_m * dt))
-            ft = (-fmag / vtn) * vt
-        F = fn * n + ft
-        tau = np.cross(r, F)
+            ft_scale = -fmag / vtn
+        for q in range(3):
+            F[q] = fn * n[q] + ft_scale * vt[q]
+        tau[0] = r[1] * F[2] - r[2] * F[1]
+        tau[1] = r[2] * F[0] - r[0] * F[2]
+        tau[2] = r[0] * F[1] - r[1] * F[0]
         for q in range(3):
             ball_wrench[q] += F[q]
             ball_wrench[3 + q] += tau[q]

@@ -32,20 +32,23 @@ def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, 
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
-        d0, d1, d2, ln = _spring_vector(x, a, b)
-        if ln <= 0.0 or (tension_only[s] and ln < l0[s]):
+        d0 = x[a, 0] - x[b, 0]
+        d1 = x[a, 1] - x[b, 1]
+        d2 = x[a, 2] - x[b, 2]
+        l2 = d0 * d0 + d1 * d1 + d2 * d2
+        # slack cords are skipped on the squared length: no square root for them
+        if l2 <= 0.0 or (tension_only[s] and l2 < l0[s] * l0[s]):
             continue
-        u0 = d0 / ln
-        u1 = d1 / ln
-        u2 = d2 / ln
-        vr = (v[a, 0] - v[b, 0]) * u0 + (v[a, 1] - v[b, 1]) * u1 + (v[a, 2] - v[b, 2]) * u2
-        mag = -k[s] * (ln - l0[s]) - kd[s] * vr
-        f[a, 0] += mag * u0
-        f[a, 1] += mag * u1
-        f[a, 2] += mag * u2
-        f[b, 0] -= mag * u0
-        f[b, 1] -= mag * u1
-        f[b, 2] -= mag * u2
+        inv = 1.0 / np.sqrt(l2)
+        vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1
+              + (v[a, 2] - v[b, 2]) * d2) * inv
+        mag = (-k[s] * (l2 * inv - l0[s]) - kd[s] * vr) * inv  # times d = times u * length
+        f[a, 0] += mag * d0
+        f[a, 1] += mag * d1
+        f[a, 2] += mag * d2
+        f[b, 0] -= mag * d0
+        f[b, 1] -= mag * d1
+        f[b, 2] -= mag * d2
     for r in range(a_idx.shape[0]):
         p = a_idx[r]
         for c in range(3):
