@@ -114,3 +114,23 @@ def test_hermite_playback_is_exact_for_cubics():
         x, xd = tr.sample(s)
         np.testing.assert_allclose(x, f(np.array(s)), atol=1e-14)
         np.testing.assert_allclose(xd, df(np.array(s)), atol=1e-12)
+
+
+def test_an_unstable_pass_is_rerun_with_a_smaller_step_and_reported():
+    # at 1e-4 s the explicit net passes the static bound but the ball's contact blows it up;
+    # the scheduler must notice (strain past 100%), rerun the pass at 1e-5 s and say so
+    scene = B.build("one-way", duration=0.45, dt=1e-4)
+    result = scene.simulate()
+    assert len(result.warnings) == 1
+    w = result.warnings[0]
+    assert w.startswith("net: strain") and "reran the pass with net dt=1e-05 s (was 0.0001 s)" in w
+    assert result.diagnostics()["net"]["instability"] == [w]
+    assert result.summary()["systems"][1]["dt_s"] == pytest.approx(1e-5)
+    assert result.diagnostics()["net"]["max_strain"] < 1.0  # the rerun is healthy
+
+
+def test_without_refinement_the_blow_up_is_an_error():
+    from interplay.errors import StabilityError
+    scene = B.build("one-way", duration=0.45, dt=1e-4)
+    with pytest.raises(StabilityError, match=r"net: strain .* try a smaller --dt"):
+        scene.simulate(refine_unstable=False)
