@@ -98,6 +98,7 @@ class Result:
                  "instability": [w for w in self.warnings if w.startswith(s.name + ":")]}
             if s.name in mon.strain:
                 d["max_strain"] = float(max(mon.strain[s.name], default=0.0))
+            d.update(s.extra_diagnostics())
             out[s.name] = d
         return out
 

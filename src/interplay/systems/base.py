@@ -64,6 +64,11 @@ class System:
         """Linear momentum (kg m/s)."""
         return np.zeros(3)
 
+    def extra_diagnostics(self) -> dict:
+        """System-specific entries for summary.json's diagnostics (e.g. the water's volume
+        drift); merged into the generic ones."""
+        return {}
+
     def health(self) -> list[str]:
         """Warnings about the current state (non-finite values, runaway strain); empty if fine."""
         x, v = self.generalized_state()
