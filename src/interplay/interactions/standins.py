@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import require_nonnegative
+from ..errors import require_nonnegative, require_positive
 from ..kernels.contact import sphere_segment_overlap
 from .base import StandIn
 
@@ -51,3 +51,49 @@ class DampingField(StandIn):
         ball.force += f
         ball.torque += tau
         return f, tau, True
+
+
+@dataclass(frozen=True)
+class ViscousDragFieldParams:
+    """A still-water stand-in. surface: height of the still surface (m); linear (N s/m) and
+    quadratic (N s^2/m^2) drag at full submersion, scaled by the submerged fraction;
+    density (kg/m^3): > 0 adds buoyancy density g V_sub (Archimedes at the still surface),
+    0 leaves it out (a diver's damping field); gravity (m/s^2)."""
+    surface: float = 0.0  # m
+    linear: float = 2.0  # N s/m
+    quadratic: float = 20.0  # N s^2/m^2
+    density: float = 0.0  # kg/m^3
+    gravity: float = 9.81  # m/s^2
+    enabled: bool = True
+
+
+class ViscousDragField(StandIn):
+    """Drag on the submerged part of a body below a flat surface (hybrid coupling with water):
+    F = -(linear + quadratic |v|) f v + density g V f z_hat, with f the submerged fraction of
+    an upright ellipsoid of half-height ``half_height`` (m) and volume ``volume`` (m^3):
+    f = t^2 (3 - 2 t), t the immersed share of its height (exact for a sphere's cap)."""
+
+    name = "viscous drag field"
+
+    def __init__(self, params: ViscousDragFieldParams, half_height: float, volume: float):
+        require_nonnegative("viscous drag field", "linear", params.linear, "N s/m")
+        require_nonnegative("viscous drag field", "quadratic", params.quadratic, "N s^2/m^2")
+        require_nonnegative("viscous drag field", "density", params.density, "kg/m^3")
+        self.p = params
+        self.half_height = require_positive("viscous drag field", "half_height", half_height,
+                                            "m")
+        self.volume = require_nonnegative("viscous drag field", "volume", volume, "m^3")
+        self._zero = np.zeros(3)
+
+    def act(self, body):
+        p = self.p
+        t = min(max((p.surface - body.x[2] + self.half_height) / (2.0 * self.half_height),
+                    0.0), 1.0)
+        if not p.enabled or t <= 0.0:
+            return self._zero, self._zero, False
+        f = t * t * (3.0 - 2.0 * t)
+        v = body.v
+        force = -(p.linear + p.quadratic * float(np.linalg.norm(v))) * f * v
+        force[2] += p.density * p.gravity * self.volume * f
+        body.add_wrench(force)
+        return force, self._zero, True

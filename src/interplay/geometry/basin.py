@@ -1,0 +1,75 @@
+"""Basins for the water: a grid of columns, a fluid mask (walls where it is False), a bed with
+a sloping shore, and the still-water depth of every column."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, require_nonnegative, require_positive
+
+SHAPES = ("ellipse", "rectangle")
+
+
+@dataclass(frozen=True)
+class BasinParams:
+    """A basin centred on the origin. size_x, size_y: extent of the grid (m); cells: columns
+    along x (the spacing is size_x / cells); depth: still water over the flat bed at z = 0 (m);
+    shore: width (m) of the bed's slope up to the rim; rim: height of the bed at the rim as a
+    multiple of depth (> 1 leaves a dry beach); shape: ellipse or rectangle."""
+    size_x: float = 2.0  # m
+    size_y: float = 2.0  # m
+    cells: int = 128
+    depth: float = 0.3  # m
+    shore: float = 0.3  # m
+    rim: float = 1.3  # x depth
+    shape: str = "ellipse"
+
+
+@dataclass(frozen=True)
+class Basin:
+    """Column grid: bed heights (m), fluid mask, depths (m), spacing l (m), origin: the centre
+    (m) of column (0, 0)."""
+    bed: np.ndarray
+    fluid: np.ndarray
+    depth: np.ndarray
+    spacing: float
+    origin: tuple
+
+
+def basin(p: BasinParams) -> Basin:
+    """Build the basin; ParameterError for sizes, depths or shapes out of range."""
+    sx = require_positive("basin", "size_x", p.size_x, "m")
+    sy = require_positive("basin", "size_y", p.size_y, "m")
+    depth = require_nonnegative("basin", "depth", p.depth, "m")
+    shore = require_nonnegative("basin", "shore", p.shore, "m")
+    if int(p.cells) < 4:
+        raise ParameterError(f"basin: cells must be at least 4, got {p.cells}")
+    if p.shape not in SHAPES:
+        raise ParameterError(f"basin: unknown shape {p.shape!r}; choose {' or '.join(SHAPES)}")
+    if not p.rim >= 1.0:
+        raise ParameterError(f"basin: rim must be >= 1 (x depth), got {p.rim}; below 1 the "
+                             "water would stand above the shore")
+    nx = int(p.cells)
+    l = sx / nx
+    ny = max(4, int(round(sy / l)))
+    x = (np.arange(nx) - 0.5 * (nx - 1)) * l
+    y = (np.arange(ny) - 0.5 * (ny - 1)) * l
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    # walls: one ring of columns at least, so the outer pipes are closed
+    ax, ay = 0.5 * sx - l, 0.5 * ny * l - l
+    if p.shape == "ellipse":
+        rho = np.sqrt((X / ax) ** 2 + (Y / ay) ** 2)
+        fluid = rho <= 1.0
+        inset = (1.0 - rho) * min(ax, ay)  # distance to the rim, approximately (m)
+    else:
+        fluid = (np.abs(X) <= ax) & (np.abs(Y) <= ay)
+        inset = np.minimum(ax - np.abs(X), ay - np.abs(Y))
+    rim = p.rim * depth
+    if shore > 0.0:
+        bed = rim * np.clip(1.0 - inset / shore, 0.0, 1.0)
+    else:
+        bed = np.zeros_like(X)
+    bed = np.where(fluid, bed, rim)
+    d = np.where(fluid, np.maximum(depth - bed, 0.0), 0.0)
+    return Basin(bed=bed, fluid=fluid, depth=d, spacing=l, origin=(float(x[0]), float(y[0])))

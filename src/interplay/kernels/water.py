@@ -1,0 +1,471 @@
+"""Water kernels (O'Brien & Hodgins 1995): virtual-pipe columns, spray particles, bodies.
+
+Grid: column (i, j) has its centre at (x0 + i l, y0 + j l); arrays are (nx, ny). Each pipe is
+stored once, from a column to its neighbour in direction k: +x, +y, +x+y, +x-y, so
+``Q[k, i, j]`` (m^3/s) is the flow from (i, j) to (i + DI[k], j + DJ[k]).
+
+Heads (m): the water surface eta = bed + V / l^2 and the pressure head H = eta + ext, where
+ext = p_ext / (rho g) is the external pressure bodies exert (see ``heads``: their lids). The
+atmospheric pressure p0 is the same in every column and cancels.
+
+Flow: Qdot = c (p_a - p_b) / (rho L) = c g (H_a - H_b) / L with L the pipe length (l or
+l sqrt 2) and c = w d the pipe cross-section: w = l / (1 + sqrt 2) (our choice: with 8 pipes
+this makes the linear wave speed exactly sqrt(g d)) and d the water depth above the pipe's sill
+(the higher of the two beds), so dry pipes carry nothing. The volume moves by dt times the
+*new* flow, i.e. the flow is staggered half a step (leapfrog): the flow over the step is its
+midpoint value. The trapezoid average of old and new flow has |amplification|^2 =
+1 + (omega dt)^2 / 2 > 1 for every wave and grows without bound; the staggered form conserves
+wave energy and is stable for omega dt < 2, i.e. dt < l / sqrt(g d) (we keep 0.7 of it).
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+SQRT2 = math.sqrt(2.0)
+#: floor on the depth (m) used to turn a column's flows into a velocity (no 0/0 when dry)
+VELOCITY_DEPTH_FLOOR = 1e-3
+#: outflow limit as a fraction of the column's volume: rounding can never make it negative
+_KEEP = 1.0 - 1e-12
+
+
+@njit(cache=True, inline="always")
+def _dir(k):
+    if k == 0:
+        return 1, 0
+    if k == 1:
+        return 0, 1
+    if k == 2:
+        return 1, 1
+    return 1, -1
+
+
+@njit(cache=True, inline="always")
+def _content(H, b, lo, chord, kappa):
+    """Water (m of column height) a sample point under a body holds when the column's head is
+    H, and its slope dC/dH. Below the body's bottom lo the water is free; above it, water
+    pressed a height e into the body meets the penalty head kappa e (so e = (H - lo) /
+    (1 + kappa)), until that head reaches the chord: then the water stands on the body."""
+    if chord <= 0.0 or H <= lo:
+        return H - b, 1.0
+    if (H - lo) * kappa <= chord * (1.0 + kappa):
+        return lo - b + (H - lo) / (1.0 + kappa), 1.0 / (1.0 + kappa)
+    return H - b - chord, 1.0
+
+
+@njit(cache=True)
+def lid_level(eta, b, lo, chord, kappa):
+    """The head H (m) of a column under a body: the root of mean_s C_s(H) = eta - b (its
+    water), a monotone piecewise-linear equation solved by Newton's method kept inside a
+    bracket (exact once on the right linear piece)."""
+    ns2 = lo.shape[0]
+    target = eta - b
+    cmax = 0.0
+    for s in range(ns2):
+        cmax = max(cmax, chord[s])
+    a, z = eta, eta + cmax * (1.0 + 1.0 / kappa) + 1e-12
+    H = eta
+    for _ in range(60):
+        c = 0.0
+        dc = 0.0
+        for s in range(ns2):
+            ci, di = _content(H, b, lo[s], chord[s], kappa)
+            c += ci
+            dc += di
+        f = c / ns2 - target
+        if abs(f) <= 1e-14 * (abs(target) + abs(H)):
+            break
+        if f > 0.0:
+            z = H
+        else:
+            a = H
+        Hn = H - f * ns2 / dc
+        H = Hn if a < Hn < z else 0.5 * (a + z)
+    return H
+
+
+@njit(cache=True)
+def heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H):
+    """Fill the surface eta, the external pressure head ext and the pressure head H (m).
+
+    Bodies are given as *lids*: a column (flat index) with, at each of its sample points, the
+    bottom lo (m, not below the bed) and the length (m) of the body's vertical chord. Within a
+    column the water is hydrostatic: the free part stands at H, the part under the body is
+    held down by the pressure the body exerts (``_content``). ext = H - eta is the body's
+    pressure head; it is a function of the water's own state, so the coupling stores and
+    returns energy like a spring instead of pumping it. (Two bodies over one column add.)"""
+    nx, ny = V.shape
+    inv = 1.0 / area
+    for i in range(nx):
+        for j in range(ny):
+            eta[i, j] = bed[i, j] + V[i, j] * inv
+    for k in range(n_lid):
+        c = lid_cell[k]
+        ext[c // ny, c % ny] = 0.0
+    for k in range(n_lid):
+        c = lid_cell[k]
+        i, j = c // ny, c % ny
+        ext[i, j] += lid_level(eta[i, j], bed[i, j], lid_lo[k], lid_chord[k], kappa) - eta[i, j]
+    for i in range(nx):
+        for j in range(ny):
+            H[i, j] = eta[i, j] + ext[i, j]
+
+
+@njit(cache=True)
+def max_depth(V, fluid, area):
+    """Largest water depth (m) over the fluid columns."""
+    nx, ny = V.shape
+    m = 0.0
+    for i in range(nx):
+        for j in range(ny):
+            if fluid[i, j] and V[i, j] > m:
+                m = V[i, j]
+    return m / area
+
+
+@njit(cache=True, inline="always")
+def column_velocity(Q, V, pipe, i, j, area, w):
+    """Horizontal water velocity (m/s) of column (i, j): the mean of the pipe velocities on
+    both sides of it, sum_k (Q_out + Q_in) e_k / (4 w d) (exact for a uniform flow)."""
+    nx, ny = V.shape
+    sx = 0.0
+    sy = 0.0
+    for k in range(4):
+        di, dj = _dir(k)
+        q = Q[k, i, j]
+        a, b = i - di, j - dj
+        if a >= 0 and b >= 0 and b < ny and pipe[k, a, b]:
+            q += Q[k, a, b]
+        if k < 2:
+            sx += q * di
+            sy += q * dj
+        else:
+            sx += q * di / SQRT2
+            sy += q * dj / SQRT2
+    d = max(V[i, j] / area, VELOCITY_DEPTH_FLOOR)
+    return sx / (4.0 * w * d), sy / (4.0 * w * d)
+
+
+@njit(cache=True)
+def flow_step(V, Q, bed, pipe, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, l, g, w,
+              damping, dt, eta, H, out, rate):
+    """One step of the volume model: flows, outflow limiting, volumes. ``rate`` receives the
+    surface's vertical speed dV/dt / l^2 (m/s). Every pipe moves the same volume out of one
+    column and into the other, so the total is conserved to round-off."""
+    nx, ny = V.shape
+    heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H)
+    keep = 1.0 / (1.0 + damping * dt)  # implicit linear pipe friction (1/s)
+    for k in range(4):
+        di, dj = _dir(k)
+        coef = dt * w * g / (l * (SQRT2 if k >= 2 else 1.0))
+        for i in range(nx):
+            for j in range(ny):
+                if not pipe[k, i, j]:
+                    continue
+                a, b = i + di, j + dj
+                sill = max(eta[i, j], eta[a, b]) - max(bed[i, j], bed[a, b])
+                if sill > 0.0:
+                    Q[k, i, j] = (Q[k, i, j] + coef * sill * (H[i, j] - H[a, b])) * keep
+                else:
+                    Q[k, i, j] = 0.0
+    # outflow limiting: a column never gives more than it holds
+    out[:] = 0.0
+    for k in range(4):
+        di, dj = _dir(k)
+        for i in range(nx):
+            for j in range(ny):
+                q = Q[k, i, j]
+                if q > 0.0:
+                    out[i, j] += q
+                elif q < 0.0:
+                    out[i + di, j + dj] -= q
+    for i in range(nx):
+        for j in range(ny):
+            o = out[i, j] * dt
+            if o > V[i, j] * _KEEP:
+                out[i, j] = V[i, j] * _KEEP / o
+            else:
+                out[i, j] = 1.0
+    for k in range(4):
+        di, dj = _dir(k)
+        for i in range(nx):
+            for j in range(ny):
+                q = Q[k, i, j]
+                if q > 0.0:
+                    Q[k, i, j] = q * out[i, j]
+                elif q < 0.0:
+                    Q[k, i, j] = q * out[i + di, j + dj]
+    rate[:, :] = V
+    for k in range(4):
+        di, dj = _dir(k)
+        for i in range(nx):
+            for j in range(ny):
+                f = dt * Q[k, i, j]
+                if f != 0.0:
+                    V[i, j] -= f
+                    V[i + di, j + dj] += f
+    inv = 1.0 / (area * dt)
+    for i in range(nx):
+        for j in range(ny):
+            rate[i, j] = (V[i, j] - rate[i, j]) * inv
+
+
+@njit(cache=True, inline="always")
+def _surface_at(px, py, x0, y0, l, fluid, field, nx, ny):
+    """Bilinear interpolation of a column field at (px, py) over fluid columns only."""
+    fx = (px - x0) / l
+    fy = (py - y0) / l
+    i0 = min(max(int(math.floor(fx)), 0), nx - 2)
+    j0 = min(max(int(math.floor(fy)), 0), ny - 2)
+    tx = min(max(fx - i0, 0.0), 1.0)
+    ty = min(max(fy - j0, 0.0), 1.0)
+    s = 0.0
+    wsum = 0.0
+    for a in range(2):
+        for b in range(2):
+            if fluid[i0 + a, j0 + b]:
+                wt = (tx if a else 1.0 - tx) * (ty if b else 1.0 - ty)
+                s += wt * field[i0 + a, j0 + b]
+                wsum += wt
+    return s / wsum if wsum > 0.0 else 0.0
+
+
+@njit(cache=True)
+def emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold, fraction, vp, px,
+               pv, count, dt, ux, uy):
+    """Emit particles where the surface rises faster than ``threshold`` (m/s): the expected
+    number from a column is fraction * l^2 (rate - threshold) dt / vp, rounded stochastically,
+    placed uniformly over the column at its surface with the surface's interpolated velocity.
+    Each particle's volume vp (m^3) leaves its column. Returns the new particle count."""
+    nx, ny = V.shape
+    cap = px.shape[0]
+    n = count
+    emitting = False
+    for i in range(nx):
+        for j in range(ny):
+            if fluid[i, j] and rate[i, j] > threshold:
+                emitting = True
+    if not emitting:
+        return n
+    for i in range(nx):
+        for j in range(ny):
+            ux[i, j], uy[i, j] = column_velocity(Q, V, pipe, i, j, area, w)
+    for i in range(nx):
+        for j in range(ny):
+            if n >= cap:
+                return n
+            r = rate[i, j]
+            if not fluid[i, j] or r <= threshold:
+                continue
+            k = int(fraction * area * (r - threshold) * dt / vp + np.random.random())
+            k = min(k, int(V[i, j] / vp), cap - n)
+            for _ in range(k):
+                x = x0 + (i + np.random.random() - 0.5) * l
+                y = y0 + (j + np.random.random() - 0.5) * l
+                px[n, 0] = x
+                px[n, 1] = y
+                px[n, 2] = H[i, j]
+                pv[n, 0] = _surface_at(x, y, x0, y0, l, fluid, ux, nx, ny)
+                pv[n, 1] = _surface_at(x, y, x0, y0, l, fluid, uy, nx, ny)
+                pv[n, 2] = _surface_at(x, y, x0, y0, l, fluid, rate, nx, ny)
+                V[i, j] -= vp
+                n += 1
+    return n
+
+
+@njit(cache=True)
+def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp, dt):
+    """Ballistic flight with quadratic air drag (a = g - drag |v| v, drag in 1/m). A particle
+    that falls to the surface (or onto a wall) gives its volume to the fluid column below it
+    (the nearest fluid column, off the water). Returns the new count."""
+    nx, ny = V.shape
+    n = count
+    p = 0
+    while p < n:
+        sp = math.sqrt(pv[p, 0] ** 2 + pv[p, 1] ** 2 + pv[p, 2] ** 2)
+        pv[p, 0] -= dt * drag * sp * pv[p, 0]
+        pv[p, 1] -= dt * drag * sp * pv[p, 1]
+        pv[p, 2] += dt * (-g - drag * sp * pv[p, 2])
+        for c in range(3):
+            px[p, c] += dt * pv[p, c]
+        i = min(max(int(math.floor((px[p, 0] - x0) / l + 0.5)), 0), nx - 1)
+        j = min(max(int(math.floor((px[p, 1] - y0) / l + 0.5)), 0), ny - 1)
+        ground = H[i, j] if fluid[i, j] else bed[i, j]
+        if pv[p, 2] < 0.0 and px[p, 2] <= ground:
+            t = nearest[i, j]
+            V[t // ny, t % ny] += vp
+            n -= 1
+            for c in range(3):
+                px[p, c] = px[n, c]
+                pv[p, c] = pv[n, c]
+        else:
+            p += 1
+    return n
+
+
+@njit(cache=True)
+def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_lo, lid_chord, n_lid, kappa,
+            ext, x0, y0, l, g, w, damping, h, dt_max, cfl, eta, H, out, rate, spray_on,
+            threshold, fraction, vp, drag, px, pv, count, seed, ux, uy, track):
+    """Advance the water h seconds in equal substeps no longer than dt_max or the wave-speed
+    limit cfl * l / sqrt(g d_max (1 + kappa if bodies touch it)), rechecked each coupling
+    step; the bodies' lids are held. track = [peak particle count, min depth (m)] is updated
+    in place. Returns (particle count, substeps taken)."""
+    dmax = max_depth(V, fluid, area)
+    stiff = 1.0 + kappa if n_lid > 0 else 1.0
+    lim = cfl * l / math.sqrt(g * dmax * stiff) if dmax > 0.0 else dt_max
+    nsub = max(1, int(math.ceil(h / min(dt_max, lim) - 1e-9)))
+    dt = h / nsub
+    np.random.seed(seed)  # counter-based seeding: a rerun from a capture repeats the spray
+    nx, ny = V.shape
+    for _ in range(nsub):
+        flow_step(V, Q, bed, pipe, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, l, g,
+                  w, damping, dt, eta, H, out, rate)
+        if spray_on:
+            heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H)
+            count = emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold,
+                               fraction, vp, px, pv, count, dt, ux, uy)
+            count = move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag,
+                               vp, dt)
+        if count > track[0]:
+            track[0] = count
+        for i in range(nx):
+            for j in range(ny):
+                if fluid[i, j] and V[i, j] / area < track[1]:
+                    track[1] = V[i, j] / area
+    return count, nsub
+
+
+@njit(cache=True)
+def energy_momentum(V, Q, pipe, fluid, area, w, rho, px, pv, count, vp, out):
+    """Kinetic energy (J) and horizontal momentum (kg m/s) of the columns (from their flow
+    velocities) plus the vertical too for airborne particles: out = [E, px, py, pz]."""
+    nx, ny = V.shape
+    e = 0.0
+    mx = 0.0
+    my = 0.0
+    mz = 0.0
+    for i in range(nx):
+        for j in range(ny):
+            if fluid[i, j] and V[i, j] > 0.0:
+                u, v = column_velocity(Q, V, pipe, i, j, area, w)
+                m = rho * V[i, j]
+                e += 0.5 * m * (u * u + v * v)
+                mx += m * u
+                my += m * v
+    mp = rho * vp
+    for p in range(count):
+        e += 0.5 * mp * (pv[p, 0] ** 2 + pv[p, 1] ** 2 + pv[p, 2] ** 2)
+        mx += mp * pv[p, 0]
+        my += mp * pv[p, 1]
+        mz += mp * pv[p, 2]
+    out[0] = e
+    out[1] = mx
+    out[2] = my
+    out[3] = mz
+
+
+@njit(cache=True, inline="always")
+def _chord(c, A, x, y):
+    """Vertical chord (zlo, zhi) of the ellipsoid at (x, y); zlo > zhi when it misses."""
+    dx = x - c[0]
+    dy = y - c[1]
+    bq = A[0, 2] * dx + A[1, 2] * dy
+    cq = A[0, 0] * dx * dx + 2.0 * A[0, 1] * dx * dy + A[1, 1] * dy * dy - 1.0
+    disc = bq * bq - A[2, 2] * cq
+    if disc <= 0.0:
+        return 1.0, 0.0
+    r = math.sqrt(disc)
+    return c[2] + (-bq - r) / A[2, 2], c[2] + (-bq + r) / A[2, 2]
+
+
+@njit(cache=True)
+def add_ellipsoid(c, A, M, full_volume, bed, fluid, x0, y0, l, ns, lid_cell, lid_lo,
+                  lid_chord, n):
+    """Append the lids of the ellipsoid {p : (p - c)^T A (p - c) <= 1} (M = A^-1: its
+    horizontal half extents are sqrt(M00), sqrt(M11)) from index n: one per fluid column its
+    shadow touches, sampled at ns x ns points; chords are clipped at the bed (no water below
+    it) and scaled by full_volume / (sampled volume) so the sampled body has its exact volume.
+    Returns the new count, or -1 if the buffers are too small."""
+    nx, ny = bed.shape
+    ex = math.sqrt(M[0, 0])
+    ey = math.sqrt(M[1, 1])
+    i_lo = int(math.floor((c[0] - ex - x0) / l + 0.5))
+    i_hi = int(math.floor((c[0] + ex - x0) / l + 0.5))
+    j_lo = int(math.floor((c[1] - ey - y0) / l + 0.5))
+    j_hi = int(math.floor((c[1] + ey - y0) / l + 0.5))
+    da = 1.0 / (ns * ns)
+    sampled = 0.0
+    start = n
+    for i in range(i_lo, i_hi + 1):
+        for j in range(j_lo, j_hi + 1):
+            inside = 0 <= i < nx and 0 <= j < ny and fluid[i, j]
+            if inside and n >= lid_cell.shape[0]:
+                return -1
+            touched = False
+            for si in range(ns):
+                x = x0 + (i - 0.5 + (si + 0.5) / ns) * l
+                for sj in range(ns):
+                    zlo, zhi = _chord(c, A, x, y0 + (j - 0.5 + (sj + 0.5) / ns) * l)
+                    s = si * ns + sj
+                    if zhi <= zlo:
+                        if inside:
+                            lid_lo[n, s] = 0.0
+                            lid_chord[n, s] = 0.0
+                        continue
+                    sampled += (zhi - zlo) * da * l * l
+                    if inside:
+                        lo = max(zlo, bed[i, j])
+                        lid_lo[n, s] = lo
+                        lid_chord[n, s] = max(zhi - lo, 0.0)
+                        touched = touched or zhi > lo
+            if inside and touched:
+                lid_cell[n] = i * ny + j
+                n += 1
+    if sampled > 0.0:
+        scale = full_volume / sampled
+        for k in range(start, n):
+            for s in range(ns * ns):
+                lid_chord[k, s] *= scale
+    return n
+
+
+@njit(cache=True)
+def lid_load(V, Q, pipe, bed, area, rate, lid_cell, lid_lo, lid_chord, start, stop, kappa,
+             x0, y0, l, w, out):
+    """What the water does to the body whose lids are [start, stop): out = [displaced volume
+    (m^3: the sum of pressure head times column area, so rho g out[0] is the force), centre of
+    buoyancy (3) m, water velocity (3) m/s]; the velocity is load-weighted, horizontal from the
+    flows, vertical the surface's."""
+    nx, ny = V.shape
+    ns2 = lid_lo.shape[1]
+    ns = int(round(math.sqrt(ns2)))
+    out[:] = 0.0
+    tot = 0.0
+    for k in range(start, stop):
+        cell = lid_cell[k]
+        i, j = cell // ny, cell % ny
+        b = bed[i, j]
+        e = b + V[i, j] / area
+        H = lid_level(e, b, lid_lo[k], lid_chord[k], kappa)
+        col = 0.0
+        for s in range(ns2):
+            c, _ = _content(H, b, lid_lo[k, s], lid_chord[k, s], kappa)
+            head = H - b - c  # what the body keeps out of this sample (m)
+            if head <= 0.0:
+                continue
+            dv = head * area / ns2
+            col += dv
+            out[1] += dv * (x0 + (i - 0.5 + (s // ns + 0.5) / ns) * l)
+            out[2] += dv * (y0 + (j - 0.5 + (s % ns + 0.5) / ns) * l)
+            out[3] += dv * (lid_lo[k, s] + 0.5 * head)
+        if col > 0.0:
+            tot += col
+            u, v = column_velocity(Q, V, pipe, i, j, area, w)
+            out[4] += col * u
+            out[5] += col * v
+            out[6] += col * rate[i, j]
+    if tot > 0.0:
+        for r in range(1, 7):
+            out[r] /= tot
+        out[0] = tot

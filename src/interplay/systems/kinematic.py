@@ -1,0 +1,112 @@
+"""Animation-driven systems (SPEC 2.3, last point): bodies that follow keyframes and ignore
+forces. Nothing pushes back on them, so they are primaries of one-way interactions."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, require_positive
+from .base import System
+
+
+@dataclass(frozen=True)
+class KeyframedBodyParams:
+    """times (s, increasing) and positions (m, flat x, y, z per key) of the body's centre;
+    semi_axes (m) of its ellipsoid shape in the body frame (x forward); yaw (rad) about +z;
+    mass (kg: what the analysis divides interaction forces by); dt (s): its step (any step is
+    exact: the path is a function of time)."""
+    times: tuple = (0.0, 1.0)
+    positions: tuple = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+    semi_axes: tuple = (0.13, 0.05, 0.045)  # m
+    yaw: float = 0.0  # rad
+    mass: float = 1.1  # kg
+    dt: float = 0.01  # s
+
+
+class KeyframedBody(System):
+    """An ellipsoid whose centre follows keyframes by monotone cubic Hermite interpolation
+    (PCHIP: positions and velocities continuous, no overshoot between keys, so a foot planted
+    by two equal keys stays still). Before the first key and after the last it holds still.
+
+    State: position x (m) and velocity v (m/s); orientation q (w, x, y, z) is fixed. Forces
+    are accepted and ignored (``add_wrench``)."""
+
+    kind = "kinematic"
+    integrator = "keyframes (monotone cubic Hermite)"
+
+    def __init__(self, name, params: KeyframedBodyParams = KeyframedBodyParams()):
+        super().__init__(name, params.dt)
+        from scipy.interpolate import PchipInterpolator
+        t = np.asarray(params.times, dtype=float)
+        p = np.asarray(params.positions, dtype=float)
+        if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t)):
+            raise ParameterError(f"{name}: needs at least 2 key times, got {params.times}")
+        if not np.all(np.diff(t) > 0.0):
+            raise ParameterError(f"{name}: key times must increase strictly, got {tuple(t)}")
+        if p.size != 3 * len(t) or not np.all(np.isfinite(p)):
+            raise ParameterError(f"{name}: positions must hold x, y, z for each of the {len(t)} "
+                                 f"keys ({3 * len(t)} numbers), got {p.size}")
+        self.semi_axes = np.array([require_positive(name, "semi-axis", a, "m")
+                                   for a in params.semi_axes])
+        if self.semi_axes.size != 3:
+            raise ParameterError(f"{name}: semi_axes needs 3 lengths, got {params.semi_axes}")
+        self._mass = require_positive(name, "mass", params.mass, "kg")
+        self.params = params
+        self._path = PchipInterpolator(t, p.reshape(-1, 3), axis=0, extrapolate=False)
+        self._vel = self._path.derivative()
+        self._t0, self._t1 = float(t[0]), float(t[-1])
+        c, s = math.cos(0.5 * params.yaw), math.sin(0.5 * params.yaw)
+        self.q = np.array([c, 0.0, 0.0, s])
+        self.rotation = np.array([[math.cos(params.yaw), -math.sin(params.yaw), 0.0],
+                                  [math.sin(params.yaw), math.cos(params.yaw), 0.0],
+                                  [0.0, 0.0, 1.0]])
+        self.x = np.zeros(3)
+        self.v = np.zeros(3)
+        self._place(0.0)
+
+    def _place(self, t):
+        tc = min(max(t, self._t0), self._t1)
+        self.x[:] = self._path(tc)
+        self.v[:] = self._vel(tc) if self._t0 < t < self._t1 else 0.0
+
+    @property
+    def mass(self):
+        return self._mass
+
+    def add_wrench(self, force, torque=None, point=None):
+        """Ignored: the animation decides the motion."""
+
+    def step(self, h):
+        """Move along the keyframes by h seconds (a kinematic body has no substeps)."""
+        self.time += h
+        self._place(self.time)
+
+    def advance(self, h):
+        self.step(h)
+
+    def ellipsoid(self):
+        """(semi-axes (3,) m, rotation (3, 3) body to world) of the body's shape."""
+        return self.semi_axes, self.rotation
+
+    def lowest_z(self):
+        """Height (m) of the body's lowest point."""
+        M = self.rotation @ np.diag(self.semi_axes ** 2) @ self.rotation.T
+        return float(self.x[2] - math.sqrt(M[2, 2]))
+
+    def kinetic_energy(self):
+        return 0.5 * self._mass * float(self.v @ self.v)
+
+    def momentum(self):
+        return self._mass * self.v.copy()
+
+    def generalized_state(self):
+        return self.x, self.v
+
+    def set_generalized_state(self, x, xdot):
+        self.x[:] = x
+        self.v[:] = xdot
+
+    def frame(self):
+        return {"position": self.x.copy(), "orientation": self.q.copy()}
