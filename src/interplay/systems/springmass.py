@@ -129,6 +129,39 @@ class SpringNetwork(System):
         self.cg_iterations = 0
         self.check_step(self.dt)
 
+    @classmethod
+    def from_mesh(cls, name, vertices, triangles, total_mass, stretch, shear=None, bend=None,
+                  masses="area", stiffen=None, **kw) -> "SpringNetwork":
+        """A network from a triangle mesh (``geometry.mesh``): structural springs on edges,
+        shear and bending springs across interior edges, k = ratio / rest length.
+
+        vertices (n,3) m, triangles (m,3); total_mass kg spread by incident area or uniformly
+        (masses="area" | "uniform"); stretch, shear, bend: stress/strain ratios (N) of each
+        kind (shear defaults to stretch, bend to stretch / 100); stiffen: (vertex indices,
+        factor) multiplies the stiffness of structural springs joining two of those vertices
+        (a leaf's vein). Other keywords go to ``SpringNetwork``. The result carries
+        ``triangles`` so renderers draw it as a surface.
+        """
+        from ..geometry import mesh as M
+        ms = M.mesh_springs(vertices, triangles, total_mass, masses, name)
+        x, t = M.validate(vertices, triangles, name)
+        shear = stretch if shear is None else shear
+        bend = stretch / 100.0 if bend is None else bend
+        k = M.spring_stiffness(x, ms.pairs, ms.kind, stretch, shear, bend)
+        if stiffen is not None:
+            idx, factor = stiffen
+            on = np.zeros(len(x), dtype=bool)
+            on[np.asarray(idx, dtype=np.int64)] = True
+            sel = (ms.kind == 0) & on[ms.pairs[:, 0]] & on[ms.pairs[:, 1]]
+            k[sel] *= require_positive(name, "stiffen factor", factor)
+        rest = np.linalg.norm(x[ms.pairs[:, 0]] - x[ms.pairs[:, 1]], axis=1)
+        springs = Springs(ms.pairs[:, 0].copy(), ms.pairs[:, 1].copy(), rest, k,
+                          np.zeros(len(rest), dtype=bool))
+        net = cls(name, x, ms.masses, springs, **kw)
+        net.triangles = t
+        net.spring_kind = ms.kind
+        return net
+
     @staticmethod
     def _check_springs(s: Springs, n: int):
         if len(s.i) and (s.i.min() < 0 or s.j.min() < 0 or max(s.i.max(), s.j.max()) >= n):
