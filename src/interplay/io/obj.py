@@ -30,10 +30,11 @@ def quat_matrix(q) -> np.ndarray:
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def _rows(prefix: str, a: np.ndarray, fmt: str) -> str:
+def _rows(prefix: str, a: np.ndarray, item: str, items: int) -> str:
+    """Lines "prefix item item ..." with ``items`` items each, formatted from a's rows."""
     if len(a) == 0:
         return ""
-    line = prefix + " " + " ".join([fmt] * a.shape[1]) + "\n"
+    line = prefix + " " + " ".join([item] * items) + "\n"
     return (line * len(a)) % tuple(a.reshape(-1))
 
 
@@ -41,16 +42,16 @@ def obj_text(name: str, points, tris=None, segments=None, normals=True) -> str:
     """One OBJ file: points (n,3) m, triangles (m,3) as faces with vertex normals, segments
     (s,2) as ``l`` line elements. Indices in the file are 1-based."""
     p = np.asarray(points, dtype=float)
-    out = [f"# Interplay OBJ: {name}; metres, +z up\n", f"o {name}\n", _rows("v", p, "%.6f")]
+    out = [f"# Interplay OBJ: {name}; metres, +z up\n", f"o {name}\n", _rows("v", p, "%.6f", 3)]
     if tris is not None and len(tris):
         t = np.asarray(tris, dtype=np.int64) + 1
         if normals:
-            out.append(_rows("vn", vertex_normals(p, np.asarray(tris)), "%.5f"))
-            out.append(_rows("f", np.repeat(t, 2, axis=1), "%d//%d"))
+            out.append(_rows("vn", vertex_normals(p, np.asarray(tris)), "%.5f", 3))
+            out.append(_rows("f", np.repeat(t, 2, axis=1), "%d//%d", 3))
         else:
-            out.append(_rows("f", t, "%d"))
+            out.append(_rows("f", t, "%d", 3))
     if segments is not None and len(segments):
-        out.append(_rows("l", np.asarray(segments, dtype=np.int64) + 1, "%d"))
+        out.append(_rows("l", np.asarray(segments, dtype=np.int64) + 1, "%d", 2))
     return "".join(out)
 
 

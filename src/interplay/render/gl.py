@@ -100,6 +100,7 @@ class Renderer:
         self.fbo = ctx.framebuffer(ctx.renderbuffer((self.w, self.h), 4, samples=samples),
                                    ctx.depth_renderbuffer((self.w, self.h), samples=samples))
         self.resolve = ctx.framebuffer(ctx.renderbuffer((self.w, self.h), 4))
+        self.shadow_size = int(shadow_size)
         self.shadow_tex = ctx.depth_texture((shadow_size, shadow_size))
         self.shadow_tex.compare_func = "<="
         self.shadow_tex.repeat_x = self.shadow_tex.repeat_y = False
@@ -147,8 +148,9 @@ class Renderer:
         self.uniforms.update({"u_light_vp": self.light_vp,
                               # a penumbra of ~2.5 cm, in shadow-map uv units
                               "u_spread": PENUMBRA / (2 * r),
-                              # ~4 mm of depth, against acne on lit surfaces
-                              "u_bias": 0.004 / depth})
+                              # ~4 mm of depth and 1.5 texels of normal offset
+                              "u_bias": 0.004 / depth,
+                              "u_offset": 1.5 * 2 * r / self.shadow_size})
 
     def _buffer(self, data, dynamic=False):
         buf = self.ctx.buffer(np.ascontiguousarray(data, dtype=np.float32).tobytes(),

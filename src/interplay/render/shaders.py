@@ -76,13 +76,17 @@ uniform mat4 u_light_vp;
 uniform sampler2DShadow u_shadow;
 uniform float u_spread;      // penumbra width in shadow-map uv units
 uniform float u_bias;
+uniform float u_offset;      // m: shadow lookups start this far off the surface
 uniform int u_checker;       // 1: the ground's 0.5 m checker
 uniform vec3 u_sky;          // linear RGB of the background
 uniform vec2 u_fog;          // fog start, end (m from the eye)
 out vec4 f_color;
 
 float lit_fraction(vec3 p, vec3 n) {
-    vec4 lp = u_light_vp * vec4(p, 1.0);
+    // normal offset: look up from just off the lit side of the surface, which keeps thin
+    // cords and grazing cloth free of self-shadow stripes ("acne")
+    vec3 nl = dot(n, u_light_dir) < 0.0 ? -n : n;
+    vec4 lp = u_light_vp * vec4(p + nl * u_offset, 1.0);
     vec3 c = lp.xyz / lp.w * 0.5 + 0.5;
     if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0)))) return 1.0;
     // four taps, each a hardware 2x2 comparison (bilinear PCF), on a rotated grid across the
@@ -110,9 +114,10 @@ void main() {
     float spec = pow(max(dot(n, h), 0.0), 40.0) * 0.2;
     vec3 ambient = base * mix(vec3(0.16, 0.15, 0.14), vec3(0.34, 0.36, 0.42), 0.5 + 0.5 * n.z);
     vec3 col = ambient + (base * diff * vec3(1.0, 0.96, 0.9) + spec) * sh;
+    col = 1.0 - exp(-1.6 * col);  // exposure: a lit white cloth keeps its shading, no clipping
     float fog = clamp((length(u_eye - v_pos) - u_fog.x) / (u_fog.y - u_fog.x), 0.0, 1.0);
     col = mix(col, u_sky, fog);
-    f_color = vec4(pow(col, vec3(1.0 / 2.2)), 1.0);
+    f_color = vec4(pow(col, vec3(1.0 / 2.2)), 1.0);  // gamma 2.2
 }
 """
 

@@ -1,0 +1,164 @@
+"""Every output of a run, from the generic Result with no scene-specific code.
+
+``write_outputs(result, out_dir)`` writes, into out_dir:
+  summary.json, tracks.npz   (Result.save)
+  scene.json                 shapes for redrawing (the web viewer reads it)
+  run.usdc | run.usda        the USD stage
+  obj/                       OBJ sequences
+  preview.mp4                the preview video
+  report.html + plot_*.png   the run report
+``write_compare_outputs`` adds, above the per-mode folders of ``interplay compare``, the
+side-by-side video compare.mp4 and the compare report.html.
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import InterplayError
+from .render.camera import Camera
+
+
+@dataclass(frozen=True)
+class OutputOptions:
+    """What to write. size: video (width, height) px; video_fps: frames/s of the videos
+    (sampled by time from the run's frames); camera: None frames every system."""
+    usd: bool = True
+    usd_format: str = "usdc"
+    obj: bool = True
+    video: bool = True
+    report: bool = True
+    size: tuple = (1280, 720)
+    video_fps: float = 30.0
+    camera: Camera | None = None
+    quiet: bool = False
+    timings: dict = field(default_factory=dict, compare=False)
+
+
+def ensure_writable(out_dir) -> Path:
+    """Create out_dir if needed and check a file can be written there, before any long work.
+    Raises InterplayError naming the directory and the fix."""
+    d = Path(out_dir)
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test.", dir=d)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as e:
+        raise InterplayError(f"cannot write to output directory {d}: {e.strerror or e}; choose "
+                             "another --out directory") from None
+    return d
+
+
+class StepBar:
+    """progress(done, total) for rendering and export: a rich bar that appears only when the
+    task has run for more than a second (short tasks stay silent)."""
+
+    def __init__(self, label: str, quiet: bool = False, after_s: float = 1.0):
+        self.label, self.quiet, self.after_s = label, quiet, after_s
+        self._t0 = time.perf_counter()
+        self._bar = self._task = None
+
+    def __call__(self, done: int, total: int):
+        if self.quiet:
+            return
+        if self._bar is None and done < total and time.perf_counter() - self._t0 > self.after_s:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+            from rich.progress import TimeRemainingColumn
+            self._bar = Progress(TextColumn(self.label), BarColumn(), MofNCompleteColumn(),
+                                 TimeRemainingColumn())
+            self._bar.start()
+            self._task = self._bar.add_task(self.label, total=total)
+        if self._bar is not None:
+            self._bar.update(self._task, completed=done)
+            if done >= total:
+                self._bar.stop()
+                self._bar = None
+
+
+def _timed(timings, key, fn, *args, **kw):
+    t0 = time.perf_counter()
+    out = fn(*args, **kw)
+    timings[key] = time.perf_counter() - t0
+    return out
+
+
+def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
+                  summary: dict | None = None) -> list[Path]:
+    """Write every output of one run into out_dir; return the paths, in order.
+
+    summary: the dict to save as summary.json (default ``result.summary()``). Wall times of
+    each output land in ``options.timings`` (s): usd_s, obj_s, video_render_s,
+    video_encode_s, report_s.
+    """
+    from .io.scenefile import from_result, write_scene_file
+    out = ensure_writable(out_dir)
+    summary = summary if summary is not None else result.summary()
+    run = from_result(result)
+    tm = options.timings
+    paths = list(result.save(out, summary))
+    files = {"summary (JSON)": paths[0], "tracks (NumPy npz)": paths[1]}
+    paths.append(write_scene_file(run, out))
+    files["shapes for the viewer"] = paths[-1]
+    if options.usd:
+        from .io.usd import write_usd
+        p = _timed(tm, "usd_s", write_usd, run, out / f"run.{options.usd_format}",
+                   options.usd_format)
+        paths.append(p)
+        files["USD stage"] = p
+    if options.obj:
+        from .io.obj import write_obj_sequence
+        _timed(tm, "obj_s", write_obj_sequence, run, out / "obj",
+               StepBar("OBJ sequence", options.quiet))
+        paths.append(out / "obj")
+        files["OBJ sequences (one file per frame)"] = out / "obj"
+    video = None
+    if options.video:
+        from .render.video import render_video
+        st = render_video(run, out / "preview.mp4", options.size, options.video_fps,
+                          options.camera, StepBar("rendering preview.mp4", options.quiet))
+        tm.update({"video_render_s": st["render_s"], "video_encode_s": st["encode_s"],
+                   "video_frames": st["frames"]})
+        video = st["path"]
+        paths.append(video)
+        files["preview video (H.264)"] = video
+    if options.report:
+        from .report import write_run_report
+        shown = {k: v for k, v in tm.items() if k.endswith("_s")}
+        written = _timed(tm, "report_s", write_run_report, result, out, summary, files, video,
+                         shown)
+        paths += written  # the plots, then report.html
+    return paths
+
+
+def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
+                          options: OutputOptions = OutputOptions(),
+                          mode_dirs: dict | None = None) -> list[Path]:
+    """The compare level: compare.mp4 (the modes side by side) and report.html linking each
+    mode's own report. results: {mode: Result}; rows: {mode: report_text.mode_row}."""
+    from .io.scenefile import from_result
+    out = ensure_writable(out_dir)
+    runs = {m: from_result(r) for m, r in results.items()}
+    paths = []
+    video = None
+    if options.video:
+        from .render.video import render_side_by_side
+        st = render_side_by_side(runs, out / "compare.mp4", options.size, options.video_fps,
+                                 options.camera,
+                                 StepBar("rendering compare.mp4", options.quiet))
+        options.timings.update({"compare_render_s": st["render_s"],
+                                "compare_encode_s": st["encode_s"]})
+        video = st["path"]
+        paths.append(video)
+    if options.report:
+        from .report import write_compare_report
+        mode_dirs = mode_dirs or {m: out / m for m in results}
+        reports = {m: d / "report.html" for m, d in mode_dirs.items()
+                   if (d / "report.html").exists()}
+        files = {"compare.json": out / "compare.json"} if (out / "compare.json").exists() else {}
+        written = write_compare_report(runs, out, rows, advice, video, reports, files)
+        paths += written
+    return paths
