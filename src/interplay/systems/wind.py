@@ -1,0 +1,120 @@
+"""Wind fields (SPEC 2.2): a sum of flow primitives, each possibly drifting, riding along a
+``Path`` (a bicyclist's wake) and gusting. The field ignores forces: objects do not disturb
+the wind, so every interaction with it is one-way."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, require_nonnegative
+from ..kernels import wind as K
+from .base import System
+
+KINDS = {"uniform": K.UNIFORM, "source": K.SOURCE, "sink": K.SOURCE, "vortex": K.VORTEX}
+
+
+@dataclass(frozen=True)
+class FlowPrimitive:
+    """One primitive. kind: uniform | source | sink | vortex (formulas in ``kernels.wind``).
+
+    position (m) of the centre at t = 0; axis: the flow direction (uniform) or the vortex
+    axis (normalized here); strength: U m/s, q m^3/s (a sink draws in q) or Gamma m^2/s;
+    core (m): the regularizing core radius r_c; velocity (m/s): a constant drift; gust: the
+    relative amplitude of the strength's fluctuation, gust_period (s) its main period and
+    phase (rad) its offset, so several primitives need not gust in step. With a ``path``,
+    position and axis are in the path's moving frame (x forward, z up) and ride along it.
+    """
+    kind: str = "uniform"
+    position: tuple = (0.0, 0.0, 0.0)
+    axis: tuple = (1.0, 0.0, 0.0)
+    strength: float = 1.0
+    core: float = 0.1
+    velocity: tuple = (0.0, 0.0, 0.0)
+    gust: float = 0.0
+    gust_period: float = 3.0
+    phase: float = 0.0
+    path: object = None
+
+    def checked(self, owner: str) -> "FlowPrimitive":
+        if self.kind not in KINDS:
+            raise ParameterError(f"{owner}: unknown flow primitive {self.kind!r}; choose one of "
+                                 f"{', '.join(KINDS)}")
+        a = np.asarray(self.axis, dtype=float)
+        if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0.0:
+            raise ParameterError(f"{owner}: {self.kind} axis must be a non-zero 3-vector, got "
+                                 f"{self.axis}")
+        for name, unit in (("core", "m"), ("gust", ""), ("gust_period", "s")):
+            require_nonnegative(owner, f"{self.kind} {name}", getattr(self, name), unit)
+        if self.gust_period == 0.0 and self.gust > 0.0:
+            raise ParameterError(f"{owner}: a gusting {self.kind} needs gust_period > 0 s")
+        if not math.isfinite(self.strength):
+            raise ParameterError(f"{owner}: {self.kind} strength must be finite, got "
+                                 f"{self.strength}")
+        return self
+
+    def gust_factor(self, t: float) -> float:
+        """1 + gust g(t), g a sum of three incommensurate sines scaled into [-1, 1]: smooth
+        and irregular enough to read as gusts without a random state to carry."""
+        if self.gust == 0.0:
+            return 1.0
+        w = 2.0 * math.pi * t / self.gust_period
+        g = (math.sin(w + self.phase) + 0.6 * math.sin(1.73 * w + 2.1 + self.phase)
+             + 0.35 * math.sin(3.31 * w + 4.2 + self.phase)) / 1.95
+        return 1.0 + self.gust * g
+
+
+class WindField(System):
+    """The air: a static system (never stepped by the scheduler, infinitely massive) whose
+    ``velocity(points, t)`` any interaction may sample. dt is irrelevant (its state is a
+    function of time)."""
+
+    kind = "wind"
+    dynamic = False
+
+    def __init__(self, name="wind", primitives=()):
+        super().__init__(name, dt=1.0)
+        self.primitives = [p.checked(name) for p in primitives]
+
+    @property
+    def mass(self):
+        return np.inf
+
+    def step(self, h):
+        self.time += h
+
+    def arrays(self, t: float):
+        """(kind, centre, axis, strength, core) arrays of the primitives at time t."""
+        n = len(self.primitives)
+        kind = np.empty(n, np.int64)
+        centre, axis = np.empty((n, 3)), np.empty((n, 3))
+        strength, core = np.empty(n), np.empty(n)
+        for q, p in enumerate(self.primitives):  # a handful of primitives, not per point
+            c = np.asarray(p.position, float)
+            a = np.asarray(p.axis, float) / np.linalg.norm(p.axis)
+            if p.path is not None:
+                origin, R = p.path.frame(t)
+                c, a = origin + R @ c, R @ a
+            centre[q] = c + np.asarray(p.velocity, float) * t
+            axis[q] = a
+            kind[q] = KINDS[p.kind]
+            strength[q] = (-1.0 if p.kind == "sink" else 1.0) * p.strength * p.gust_factor(t)
+            core[q] = p.core
+        return kind, centre, axis, strength, core
+
+    def velocity(self, points, t: float) -> np.ndarray:
+        """Wind velocity (m/s) at points (n,3) m at time t (s)."""
+        pts = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
+        out = np.empty_like(pts)
+        K.sample(pts, *self.arrays(t), out)
+        return out
+
+    def generalized_state(self):
+        return np.zeros(0), np.zeros(0)
+
+    def set_generalized_state(self, x, xdot):
+        pass
+
+    def frame(self):
+        return {}
