@@ -1,4 +1,4 @@
-"""The ``interplay`` command: list, run, compare and fit-standin.
+"""The ``interplay`` command: list, run, compare, fit-standin and view.
 
 Errors a user can cause print one line (no traceback) and exit with status 2.
 """
@@ -30,6 +30,37 @@ def _scene_options(p):
                    help="override a scene parameter, e.g. --set net.cord_ea=300")
     p.add_argument("--out", default=None, help="output directory (default out/SCENE)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    _output_options(p)
+
+
+def _output_options(p):
+    g = p.add_argument_group("outputs (USD, OBJ, preview video, report)")
+    g.add_argument("--camera", default=None, metavar="EYE:TARGET[:FOV]",
+                   help='preview camera "eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]"'
+                        " in m and degrees (default: frame every system)")
+    g.add_argument("--size", default="1280x720", metavar="WxH", help="video size in pixels")
+    g.add_argument("--video-fps", type=float, default=30.0, help="video frames per second")
+    g.add_argument("--usda", action="store_true", help="write text .usda instead of .usdc")
+    for name in ("usd", "obj", "video", "report"):
+        g.add_argument(f"--no-{name}", action="store_true", help=f"skip the {name} output")
+
+
+def _outputs(args):
+    """OutputOptions from the command line (checked before any simulation runs)."""
+    from .outputs import OutputOptions
+    from .render.camera import parse_camera
+    w, x, h = args.size.lower().partition("x")
+    if not x or not w.isdigit() or not h.isdigit():
+        raise ParameterError(f"--size {args.size}: expected WIDTHxHEIGHT in pixels, e.g. 1280x720")
+    from .render.video import check_size
+    size = check_size((int(w), int(h)))
+    if not 1.0 <= args.video_fps <= 240.0:
+        raise ParameterError(f"--video-fps {args.video_fps:g}: choose 1 to 240 frames/s")
+    return OutputOptions(usd=not args.no_usd, usd_format="usda" if args.usda else "usdc",
+                         obj=not args.no_obj, video=not args.no_video, report=not args.no_report,
+                         size=size, video_fps=args.video_fps,
+                         camera=parse_camera(args.camera) if args.camera else None,
+                         quiet=args.quiet)
 
 
 def _parser():
@@ -43,6 +74,10 @@ def _parser():
     _scene_options(cmp_)
     fit = sub.add_parser("fit-standin", help="fit the hybrid stand-in to a two-way run")
     _scene_options(fit)
+    view = sub.add_parser("view", help="serve a saved run in a web viewer on localhost")
+    view.add_argument("dir", help="a run directory, e.g. out/basketball/two-way")
+    view.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
+    view.add_argument("--host", default="127.0.0.1", help="address to listen on")
     return ap
 
 
@@ -74,12 +109,14 @@ def _check_mode(mode):
                              f"{', '.join(MODES)}")
 
 
-def _run_one(module, mode, kw, out, quiet, console):
+def _run_one(module, mode, kw, out, quiet, console, options=None):
     from .progress import PassProgress
     scene = module.build(mode, **kw)
     result = scene.simulate(progress=PassProgress(scene.duration, quiet))
-    paths = result.save(out)
-    return result, paths
+    if options is None:
+        return result, result.save(out)
+    from .outputs import write_outputs
+    return result, write_outputs(result, out, options)
 
 
 def cmd_list(args, console):
@@ -92,7 +129,10 @@ def cmd_run(args, console):
     _check_mode(args.coupling)
     module, kw = _build_kwargs(args)
     out = Path(args.out or f"out/{args.scene}")
-    result, paths = _run_one(module, args.coupling, kw, out, args.quiet, console)
+    options = _outputs(args)
+    from .outputs import ensure_writable
+    ensure_writable(out)
+    result, paths = _run_one(module, args.coupling, kw, out, args.quiet, console, options)
     from .report_text import print_run
     print_run(console, result)
     for p in paths:
@@ -103,7 +143,7 @@ def cmd_compare(args, console):
     from .compare import compare_modes
     module, kw = _build_kwargs(args)
     out = Path(args.out or f"out/{args.scene}")
-    compare_modes(module, kw, out, args.quiet, console)
+    compare_modes(module, kw, out, args.quiet, console, _outputs(args))
 
 
 def cmd_fit(args, console):
@@ -131,7 +171,13 @@ def _vec(v):
     return "(" + ", ".join(f"{x:.3f}" for x in v) + ")"
 
 
-COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit}
+def cmd_view(args, console):
+    from .viewer import serve
+    serve(args.dir, host=args.host, port=args.port, log=lambda m: print(m, flush=True))
+
+
+COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit,
+            "view": cmd_view}
 
 
 def main(argv=None) -> int:

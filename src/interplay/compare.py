@@ -11,8 +11,14 @@ from .report_text import mode_row
 MODES = ("two-way", "one-way", "hybrid")
 
 
-def compare_modes(module, kw, out: Path, quiet: bool, console) -> dict:
-    """Run every mode, save each under out/MODE, print one table, write out/compare.json."""
+def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> dict:
+    """Run every mode, save each under out/MODE, print one table, write out/compare.json.
+
+    options: an outputs.OutputOptions to also write each mode's USD, OBJ, video and report,
+    and the side-by-side video and compare report in out (None: summary and tracks only)."""
+    if options is not None:
+        from .outputs import ensure_writable
+        ensure_writable(out)
     results = {}
     for mode in MODES:
         if not quiet:
@@ -24,15 +30,23 @@ def compare_modes(module, kw, out: Path, quiet: bool, console) -> dict:
     rows, paths = {}, []
     for mode, r in results.items():
         summary = r.summary(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
-        paths += r.save(out / mode, summary)
+        if options is None:
+            paths += r.save(out / mode, summary)
+        else:
+            from .outputs import write_outputs
+            paths += write_outputs(r, out / mode, options, summary)
         rows[mode] = mode_row(r)
     advice = results["two-way"].advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
     report = {"scene": results["two-way"].scene.name, "modes": rows, "advice": advice}
     path = out / "compare.json"
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(report, indent=2))
+    paths.append(path)
+    if options is not None:
+        from .outputs import write_compare_outputs
+        paths += write_compare_outputs(results, out, rows, advice, options)
     _print_table(console, rows, advice)
-    for p in paths + [path]:
+    for p in paths:
         console.print(f"wrote {p}")
     return report
 

@@ -26,9 +26,9 @@ def _viser():
     return viser
 
 
-def _rgb(color) -> tuple:
-    """Linear RGB 0..1 -> sRGB bytes (the browser shows sRGB)."""
-    return tuple(int(round(255 * min(max(c, 0.0), 1.0) ** (1 / 2.2))) for c in color)
+def _rgb(color, scale: float = 1.0) -> tuple:
+    """RGB 0..1 -> bytes; viser lights the scene itself, so no gamma here."""
+    return tuple(int(round(255 * min(max(c * scale, 0.0), 1.0))) for c in color)
 
 
 class Viewer:
@@ -60,7 +60,7 @@ class Viewer:
     @property
     def url(self) -> str:
         host = self.server.get_host()
-        host = "localhost" if host in ("0.0.0.0", "127.0.0.1", "localhost") else host
+        host = "localhost" if host in ("0.0.0.0", "::") else host  # listening everywhere
         return f"http://{host}:{self.server.get_port()}"
 
     def _connected(self, client):
@@ -78,7 +78,8 @@ class Viewer:
                                    shape.triangles.astype(np.uint32), color=color, side="double")
             self.handles.append(("vertices", shape.name, h))
         elif shape.form == "cords":
-            h = sc.add_line_segments(name, self._segments(shape, 0), color,
+            # thin light cords vanish on viser's white background: draw them darker
+            h = sc.add_line_segments(name, self._segments(shape, 0), _rgb(shape.color, 0.55),
                                      thickness=2.0, thickness_units="screen")
             self.handles.append(("segments", shape, h))
         elif shape.form == "particles":
@@ -108,7 +109,7 @@ class Viewer:
         gui.add_markdown(f"**{run.scene}** - {run.coupling}  \n{run.duration:g} s, "
                          f"{nf} frames at {run.fps:g} fps")
         self.slider = gui.add_slider("frame", min=0, max=max(nf - 1, 1), step=1, initial_value=0)
-        self.clock = gui.add_number("time (s)", 0.0, disabled=True)
+        self.clock = gui.add_number("time (s)", 0.0, step=0.001, disabled=True)
         self.playing = gui.add_checkbox("playing", True)
         self.speed = gui.add_slider("speed", min=0.05, max=2.0, step=0.05, initial_value=1.0)
         self.slider.on_update(lambda _: self.set_frame(int(self.slider.value)))

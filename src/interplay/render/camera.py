@@ -55,7 +55,7 @@ class Camera:
 
 def parse_camera(spec: str) -> Camera:
     """``"eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]"`` (m, m, degrees)."""
-    fix = ('--camera expects "eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]", '
+    fix = ('expected "eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]", '
            'e.g. "2,-6,2:0,0,1.5:35"')
     parts = str(spec).split(":")
     if len(parts) not in (2, 3):
