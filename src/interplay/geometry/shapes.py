@@ -127,3 +127,12 @@ def bicyclist(wheel_radius: float = 0.34, wheelbase: float = 1.05):
              creation.icosphere(subdivisions=2, radius=0.11).apply_translation(shoulder + [0.05, 0, 0.22])]
     m = trimesh.util.concatenate(parts)
     return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
+
+
+def pole(height: float, radius: float = 0.025):
+    """A vertical pole standing on the origin, `height` m tall (a cylinder)."""
+    from trimesh import creation
+    height = require_positive("pole", "height", height, "m")
+    m = creation.cylinder(radius=require_positive("pole", "radius", radius, "m"),
+                          segment=np.array([[0.0, 0.0, 0.0], [0.0, 0.0, height]]), sections=12)
+    return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)

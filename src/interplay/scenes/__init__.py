@@ -9,6 +9,7 @@ from ..errors import SceneError
 REGISTRY = {
     "basketball": ("basketball", "a basketball falls through a spring-mass net (two-way, "
                                  "one-way or hybrid)"),
+    "flags": ("flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)"),
 }
 
 

@@ -1,0 +1,119 @@
+"""Flags in the wind: several flags of different sizes and materials on poles, pinned along
+the pole edge, in a gusty wind (one-way: the air does not feel the cloth)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import SceneError
+from ..geometry import shapes
+from ..interactions.aero import AeroParams, Aerodynamics
+from ..scene import Scene
+from ..systems.path import Path, PathFollower
+from ..systems.springmass import SpringNetwork
+from ..systems.wind import FlowPrimitive, WindField
+
+
+@dataclass(frozen=True)
+class FlagParams:
+    """One flag. pole (m): where its pole stands, pole_height (m): the flag's top edge height;
+    width, height (m); nu, nv: vertices along and down the flag; density (kg/m^2); stretch,
+    shear, bend: stress/strain ratios (N), k = ratio / rest length; mass_damping (1/s),
+    stiffness_damping (s): Rayleigh; dt (s) and integrator of its own simulation; cg_tolerance:
+    the implicit solve's relative residual (1e-5 moves a point ~1e-5 of its step's change:
+    invisible, and it halves the CG iterations of 1e-8)."""
+    pole: tuple = (0.0, 0.0, 0.0)
+    pole_height: float = 3.0
+    width: float = 1.5
+    height: float = 1.0
+    nu: int = 30
+    nv: int = 20
+    density: float = 0.15  # kg/m^2: cotton bunting
+    stretch: float = 150.0  # N: ~3000 N/m membrane stiffness at this spacing, cotton-like
+    shear: float = 50.0
+    bend: float = 0.5
+    mass_damping: float = 0.05
+    stiffness_damping: float = 2e-4
+    dt: float = 1.0 / 240.0
+    integrator: str = "implicit"
+    cg_tolerance: float = 1e-5
+
+
+@dataclass(frozen=True)
+class GustyWind:
+    """speed (m/s) towards heading (deg from +x, counter-clockwise), gusting by +-gust of it
+    with main period gust_period (s); cross (m/s): a sideways component gusting out of phase
+    from 0 to 2 cross, so the wind's direction swings too."""
+    speed: float = 6.0
+    heading: float = 0.0
+    gust: float = 0.4
+    gust_period: float = 2.5
+    cross: float = 1.0
+
+
+@dataclass(frozen=True)
+class FlagsParams:
+    wind: GustyWind = GustyWind()
+    aero: AeroParams = AeroParams()
+    cotton: FlagParams = FlagParams()
+    # light nylon, small and fast
+    nylon: FlagParams = FlagParams(pole=(0.0, 3.0, 0.0), pole_height=2.5, width=0.9, height=0.6,
+                                   nu=24, nv=16, density=0.06, stretch=60.0, shear=20.0,
+                                   bend=0.1)
+    # heavy canvas banner, large and slow
+    canvas: FlagParams = FlagParams(pole=(0.0, -3.5, 0.0), pole_height=4.0, width=2.0,
+                                    height=1.2, nu=32, nv=20, density=0.35, stretch=400.0,
+                                    shear=150.0, bend=3.0)
+
+
+PARAMS = FlagsParams
+
+
+def wind_field(w: GustyWind) -> WindField:
+    h = math.radians(w.heading)
+    along, across = (math.cos(h), math.sin(h), 0.0), (-math.sin(h), math.cos(h), 0.0)
+    return WindField("wind", [
+        FlowPrimitive("uniform", axis=along, strength=w.speed, gust=w.gust,
+                      gust_period=w.gust_period),
+        FlowPrimitive("uniform", axis=across, strength=w.cross, gust=1.0 if w.cross else 0.0,
+                      gust_period=1.7 * w.gust_period, phase=2.0)])
+
+
+def flag(name: str, p: FlagParams) -> SpringNetwork:
+    """A flag streaming along +x from its pole in the xz plane, pinned along the pole edge."""
+    top = np.asarray(p.pole, float) + [0.0, 0.0, p.pole_height]
+    x, tris = shapes.grid(p.width, p.height, p.nu, p.nv, origin=top, u=(1, 0, 0), v=(0, 0, -1))
+    net = SpringNetwork.from_mesh(name, x, tris, p.density * p.width * p.height, p.stretch,
+                                  p.shear, p.bend, dt=p.dt, integrator=p.integrator,
+                                  mass_damping=p.mass_damping,
+                                  stiffness_damping=p.stiffness_damping,
+                                  cg_tolerance=p.cg_tolerance, fixed=np.arange(p.nv) * p.nu)
+    return net
+
+
+def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
+          integrator: str | None = None, dt: float | None = None,
+          params: FlagsParams = FlagsParams()) -> Scene:
+    """The scene; integrator and dt (s) override every flag's. The wind ignores forces, so
+    one-way and two-way give the same motion; there is no stand-in for hybrid."""
+    if coupling == "hybrid":
+        raise SceneError("flags: the wind has no stand-in (it does not feel the flags at all); "
+                         "use one-way")
+    scene = Scene("flags", duration=duration, fps=fps)
+    wind = scene.add(wind_field(params.wind))
+    for name in ("cotton", "nylon", "canvas"):
+        p = getattr(params, name)
+        if integrator is not None:
+            p = replace(p, integrator=integrator)
+        if dt is not None:
+            p = replace(p, dt=dt)
+        cloth = scene.add(flag(name, p))
+        pv, pt = shapes.pole(p.pole_height + 0.1)
+        here = [np.asarray(p.pole, float)] * 2
+        scene.add(PathFollower(f"{name}-pole", Path([0.0, 1.0], here), pv, pt, mass=5.0,
+                               dt=1.0 / fps))  # a frame per output frame, like the flags
+        scene.connect(Aerodynamics(f"wind-{name}", wind, cloth, params.aero, mode="one-way"))
+    scene.primary = wind
+    return scene
