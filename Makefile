@@ -7,21 +7,38 @@ STAMP := $(VENV)/.installed
 export NUMBA_THREADING_LAYER ?= workqueue
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: demo test test-all bench clean
+.PHONY: demo test test-all bench clean sysdeps browser
 
-$(STAMP): pyproject.toml
+# The preview renderer needs Mesa's EGL driver (headless OpenGL on the CPU); the slow browser
+# tests need Chromium. apt runs only when something is missing, and only as root.
+APT := DEBIAN_FRONTEND=noninteractive apt-get
+sysdeps:
+	@if ldconfig -p | grep -q libEGL_mesa && ldconfig -p | grep -q 'libGL.so.1 ' \
+		&& ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+		$(APT) update -q && $(APT) install -y -q libegl1 libegl-mesa0 libgl1-mesa-dri libgl1; \
+	else echo "note: Mesa EGL missing; install libegl1 libegl-mesa0 libgl1-mesa-dri (as root) or use --no-video"; fi
+
+browser:
+	@if command -v chromium >/dev/null; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+		$(APT) update -q && $(APT) install -y -q chromium; \
+	else echo "note: no chromium; the slow browser tests will be skipped"; fi
+
+$(STAMP): pyproject.toml | sysdeps
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[test,bench]'
+	$(BIN)/pip install -q -e '.[test,bench,viewer]'
 	touch $(STAMP)
 
 demo: $(STAMP)
 	$(BIN)/interplay compare basketball --out out/basketball
+	@echo "report: out/basketball/report.html"
 
 test: $(STAMP)
 	$(BIN)/pytest -q
 
-test-all: $(STAMP)
+test-all: $(STAMP) browser
 	$(BIN)/pytest -q -m ""
 
 bench: $(STAMP)

@@ -30,7 +30,6 @@ def _scene_options(p):
                    help="override a scene parameter, e.g. --set net.cord_ea=300")
     p.add_argument("--out", default=None, help="output directory (default out/SCENE)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
-    _output_options(p)
 
 
 def _output_options(p):
@@ -70,8 +69,10 @@ def _parser():
     run = sub.add_parser("run", help="simulate one scene in one coupling mode")
     _scene_options(run)
     run.add_argument("--coupling", default="two-way", help="two-way | one-way | hybrid")
+    _output_options(run)
     cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
     _scene_options(cmp_)
+    _output_options(cmp_)
     fit = sub.add_parser("fit-standin", help="fit the hybrid stand-in to a two-way run")
     _scene_options(fit)
     view = sub.add_parser("view", help="serve a saved run in a web viewer on localhost")

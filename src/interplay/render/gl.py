@@ -64,7 +64,7 @@ def quat_matrix4(pos, q) -> np.ndarray:
     return m
 
 
-def _unit_cylinder(sides=10):
+def _unit_cylinder(sides=6):
     a = 2 * np.pi * np.arange(sides) / sides
     ring = np.stack([np.cos(a), np.sin(a), np.zeros(sides)], axis=1)
     pos = np.concatenate([ring, ring + [0, 0, 1]])
@@ -115,7 +115,9 @@ class Renderer:
         self._objects = []
         self._resources = [self.fbo, self.resolve, self.shadow_tex, self.shadow_fbo,
                            *self.progs.values(), *self.depth.values()]
-        cyl, sph = _unit_cylinder(), _unit_sphere()
+        # cords and knots are a few pixels wide: six-sided tubes and icosahedra look round
+        # there and keep the vertex work small (llvmpipe); hooks and particles get more
+        cyl, self._knot_sphere, sph = _unit_cylinder(), _unit_sphere(0), _unit_sphere(1)
         for shape in run.shapes:
             self._add(shape, run, cyl, sph)
 
@@ -204,7 +206,7 @@ class Renderer:
             self._objects.append({"shape": shape, "kind": "cords", "vao": vao, "dvao": dvao,
                                   "inst": inst, "color": color, "radius": r, "casts": True,
                                   "count": len(shape.segments)})
-            self._knots(shape, run, sph, color, r)
+            self._knots(shape, run, self._knot_sphere, color, r)
         elif shape.form == "particles":
             self._knots(shape, run, sph, color, max(shape.width / 2, 1e-3))
         if shape.anchors is not None:
