@@ -1,0 +1,1 @@
+"""Control of active figures: PD servo gains (pd), state machines (fsm), behaviours."""

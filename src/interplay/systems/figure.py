@@ -1,0 +1,378 @@
+"""Active human figures on MuJoCo (SPEC 2.3): 17 segments, 30 PD-servoed hinges, a state-
+machine controller, MuJoCo's own ground contact, and forces from other systems through
+``xfrc_applied``.
+
+Rates: MuJoCo steps at ``dt`` and evaluates the servo law at every step (the servos are MuJoCo
+actuators with exactly the PD law of control/pd.py); the controller (state machine and balance)
+updates targets and gains every ``control_dt``; both are independent of the coupling step, which
+the figure substeps inside one Python loop over ``mj_step``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..control.fsm import Controller, StateMachine
+from ..control.pd import axis_inertias, pd_gains
+from ..errors import ParameterError, require_positive
+from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, joint_names, segment_mesh
+from .base import System
+from .figure_model import EnvironmentParams, build_model, geom_probe_points, joint_group
+
+LEG_GROUPS = ("hip", "knee", "ankle", "toe")
+FEET = ("l_foot", "l_toes", "r_foot", "r_toes")
+HANDS = ("l_hand", "r_hand")
+BALANCE_RATE = 0.5  # rad/s, fastest change of the balance offset
+BALANCE_MAX = 0.25  # rad, largest balance offset
+
+
+@dataclass(frozen=True)
+class FigureParams:
+    """body: mass and height; environment: ground and platforms; position (m): the ground point
+    below the pelvis at rest; yaw (rad): heading about +z (0 faces +x); dt (s): MuJoCo's step;
+    control_dt (s): the controller's period; omega (rad/s) and zeta (-): default servo natural
+    frequency and damping ratio."""
+    body: BodyParams = BodyParams()
+    environment: EnvironmentParams = EnvironmentParams()
+    position: tuple = (0.0, 0.0, 0.0)  # m
+    yaw: float = 0.0  # rad
+    dt: float = 1e-3  # s
+    control_dt: float = 5e-3  # s
+    omega: float = 20.0  # rad/s
+    zeta: float = 1.0
+
+
+def _qmul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+class Figure(System):
+    """An articulated human figure. Generalized state: (qpos, d qpos/dt) — for the free root
+    the quaternion's time derivative, not MuJoCo's body-frame angular velocity, so tracks can
+    Hermite-interpolate a consistent pair. Segment order is anthropometry.SEGMENTS."""
+
+    kind = "figure"
+    integrator = "MuJoCo implicitfast, PD servo actuators"
+
+    def __init__(self, name: str, params: FigureParams = FigureParams(),
+                 controller: Controller | None = None, fixed_base: bool = False,
+                 gravity: bool = True):
+        super().__init__(name, params.dt)
+        import mujoco
+        self._mj = mujoco
+        self.params = params
+        self.control_dt = require_positive(name, "control_dt", params.control_dt, "s")
+        self.plan = body_plan(params.body)
+        pos = np.asarray(params.position, dtype=float)
+        if pos.shape != (3,) or not np.all(np.isfinite(pos)):
+            raise ParameterError(f"{name}: position must be 3 finite numbers (m), got "
+                                 f"{params.position!r}")
+        self.model = build_model(self.plan, params.environment, params.dt,
+                                 root=pos + [0.0, 0.0, 5e-4], yaw=params.yaw,
+                                 fixed_base=fixed_base, gravity=gravity,
+                                 mass=params.body.mass)
+        m = self.model
+        self.data = mujoco.MjData(m)
+        self.free = not fixed_base
+        self.joints = joint_names(self.plan)
+        self.seg_body = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, s)
+                                  for s in SEGMENTS])
+        self.seg_geom = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, s)
+                                  for s in SEGMENTS])
+        self.foot_geoms = self.seg_geom[[SEGMENTS.index(s) for s in FEET]]
+        self.hand_geoms = self.seg_geom[[SEGMENTS.index(s) for s in HANDS]]
+        self.sole_geoms = self.seg_geom[[SEGMENTS.index(s) for s in ("l_foot", "r_foot")]]
+        jid = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self.joints])
+        self.qadr = m.jnt_qposadr[jid]
+        self.vadr = m.jnt_dofadr[jid]
+        self.root = self.seg_body[0]
+        self.leg = np.array([joint_group(j) in LEG_GROUPS for j in self.joints])
+        self.ankles = np.array([i for i, j in enumerate(self.joints) if joint_group(j) == "ankle"])
+        mujoco.mj_forward(m, self.data)
+        # inertia each hinge moves (rest pose): its subtree, or the rest of the body when the
+        # subtree is planted (stance legs); the hinge's armature adds to both
+        sub = np.zeros((len(jid), m.nbody), dtype=bool)
+        for k, j in enumerate(jid):
+            b0 = m.jnt_bodyid[j]
+            for b in range(1, m.nbody):
+                a = b
+                while a > 0 and a != b0:
+                    a = m.body_parentid[a]
+                sub[k, b] = a == b0
+        world = np.zeros((len(jid), m.nbody), dtype=bool)
+        world[:, 1:] = True
+        self.inertia_distal = axis_inertias(m, self.data, jid, sub) + m.dof_armature[self.vadr]
+        self.inertia_support = (axis_inertias(m, self.data, jid, world & ~sub)
+                                + m.dof_armature[self.vadr])
+        self._mass = float(m.body_mass.sum())
+        self.targets = np.zeros(len(jid))
+        self.vtargets = np.zeros(len(jid))
+        self.omega = np.full(len(jid), require_positive(name, "omega", params.omega, "rad/s"))
+        self.zeta = np.full(len(jid), require_positive(name, "zeta", params.zeta))
+        self.support = False
+        self.fsm = StateMachine(controller, self.joints) if controller is not None else None
+        self._next_control = 0.0
+        self.balance_offset = 0.0
+        self._blend = None
+        if self.fsm is not None:
+            self._enter(self.fsm.start)
+        self.apply_gains()
+        self._set_ctrl()
+        nq = m.nq
+        self._gx, self._gv = np.zeros(nq), np.zeros(nq)
+        self._probe = geom_probe_points(m, self.seg_geom)
+
+    # --- servos and control ------------------------------------------------------------------
+    def apply_gains(self):
+        """Set the actuators to the PD law for the current omega, zeta and support flag."""
+        inertia = np.where(self.support & self.leg, self.inertia_support, self.inertia_distal)
+        self.kp, self.kd = pd_gains(inertia, self.omega, self.zeta)
+        self.model.actuator_biasprm[:, 1] = -self.kp
+        self.model.actuator_biasprm[:, 2] = -self.kd
+
+    def _set_ctrl(self, t=None):
+        target, vtarget = self.targets.copy(), self.vtargets.copy()
+        if t is not None and self._blend is not None:
+            start, end, t0, T = self._blend
+            u = (t - t0) / T
+            if u >= 1.0:
+                self._blend = None
+            else:  # smoothstep 3u^2 - 2u^3 and its rate
+                u = max(u, 0.0)
+                target = start + (end - start) * (3 * u * u - 2 * u ** 3)
+                vtarget = vtarget + (end - start) * (6 * u - 6 * u * u) / T
+        if self.balance_offset:
+            target[self.ankles] += self.balance_offset
+        self.data.ctrl[:] = self.kp * target + self.kd * vtarget
+
+    def angles(self) -> np.ndarray:
+        """Current joint angles (rad), in ``joints`` order."""
+        return self.data.qpos[self.qadr].copy()
+
+    def set_targets(self, targets=None, velocities=None):
+        """Set desired joint angles (rad) and velocities (rad/s) directly (no controller)."""
+        if targets is not None:
+            self.targets[:] = targets
+        if velocities is not None:
+            self.vtargets[:] = velocities
+        self._set_ctrl()
+
+    def _enter(self, index, t=0.0):
+        start = self.targets.copy()
+        self.fsm.enter(index, t, self.targets, self.vtargets, self.angles(), self.omega,
+                       self.zeta, self.params.omega, self.params.zeta)
+        self.support = self.fsm.state.support
+        T = self.fsm.state.blend
+        self._blend = (start, self.targets.copy(), t, T) if T > 0 and t > 0 else None
+        self.apply_gains()
+
+    def sensors(self) -> dict:
+        """What transitions read: foot/hand contact, centre of mass (m) and its velocity (m/s)."""
+        d, m = self.data, self.model
+        geoms = d.contact.geom[:d.ncon]
+        self._mj.mj_subtreeVel(m, d)
+        return {"foot_contact": bool(np.isin(geoms, self.foot_geoms).any()),
+                "hand_contact": bool(np.isin(geoms, self.hand_geoms).any()),
+                "com": d.subtree_com[self.root].copy(),
+                "com_vel": d.subtree_linvel[self.root].copy()}
+
+    def _control(self, t):
+        if self.fsm is not None:
+            s = self.sensors()
+            nxt = self.fsm.fired(t, s)
+            if nxt is not None:
+                self._enter(nxt, t)
+            self.balance_offset = self._balance(s) if self.fsm.state.balance else 0.0
+            self._set_ctrl(t)
+        self._next_control += self.control_dt
+
+    def _balance(self, s) -> float:
+        """Ankle-strategy feedback (rad): plantarflex when the centre of mass is ahead of the
+        centre of the feet on the ground (the middle of the support polygon: the foot boxes'
+        centres, heel to toe joint) or moving forward, dorsiflex when behind. The offset slews
+        at most BALANCE_RATE so a large error leans the body over gradually instead of kicking
+        it off its feet; it is capped at BALANCE_MAX."""
+        d = self.data
+        geoms = d.contact.geom[:d.ncon]
+        touching = self.sole_geoms[np.isin(self.sole_geoms, geoms)]
+        if len(touching) == 0:
+            return self.balance_offset
+        centre = d.geom_xpos[touching].mean(axis=0)
+        fwd = d.xmat[self.root].reshape(3, 3)[:, 0].copy()
+        fwd[2] = 0.0
+        fwd /= max(np.linalg.norm(fwd), 1e-9)
+        kp, kd = self.fsm.state.balance
+        e = float(np.dot(s["com"] - centre, fwd))
+        v = float(np.dot(s["com_vel"], fwd))
+        want = float(np.clip(-(kp * e + kd * v), -BALANCE_MAX, BALANCE_MAX))
+        step = BALANCE_RATE * self.control_dt
+        return float(np.clip(want, self.balance_offset - step, self.balance_offset + step))
+
+    # --- dynamics ----------------------------------------------------------------------------
+    def clear_forces(self):
+        self.data.xfrc_applied[:] = 0.0
+
+    def add_wrench(self, force, torque=None, point=None, body=0):
+        """Add a force (N) at a world point (m; default the segment's centre of mass) and a
+        torque (N m) to a segment, named or by index in SEGMENTS (default the pelvis)."""
+        b = self.seg_body[SEGMENTS.index(body) if isinstance(body, str) else int(body)]
+        f = np.asarray(force, dtype=float)
+        w = self.data.xfrc_applied[b]
+        w[:3] += f
+        if point is not None:
+            w[3:] += np.cross(np.asarray(point, dtype=float) - self.data.xipos[b], f)
+        if torque is not None:
+            w[3:] += torque
+
+    def _run(self, n: int, sub: float):
+        m, d = self.model, self.data
+        if m.opt.timestep != sub:
+            m.opt.timestep = sub
+        done, t = 0, self.time
+        while done < n:
+            if t >= self._next_control - 1e-9 * sub:
+                self._control(t)
+            k = min(n - done, max(1, math.ceil((self._next_control - t) / sub - 1e-9)))
+            self._mj.mj_step(m, d, nstep=k)
+            done += k
+            t = self.time + done * sub
+        return t
+
+    def step(self, h):
+        self._run(1, h)
+
+    def advance(self, h):
+        n = max(1, math.ceil(h / self.dt - 1e-9))
+        self._run(n, h / n)
+        self.time += h
+
+    # --- measures ----------------------------------------------------------------------------
+    @property
+    def mass(self) -> float:
+        return self._mass
+
+    def com(self) -> np.ndarray:
+        """Centre of mass (m)."""
+        return self.data.subtree_com[self.root].copy()
+
+    def kinetic_energy(self):
+        res = np.zeros(self.model.nv)
+        self._mj.mj_mulM(self.model, self.data, res, self.data.qvel)
+        return 0.5 * float(np.dot(self.data.qvel, res))
+
+    def momentum(self):
+        # recompute the centre-of-mass velocities for the current state (mj_step leaves them
+        # from the start of the last step)
+        m, d = self.model, self.data
+        self._mj.mj_kinematics(m, d)
+        self._mj.mj_comPos(m, d)
+        self._mj.mj_comVel(m, d)
+        self._mj.mj_subtreeVel(m, d)
+        return self._mass * self.data.subtree_linvel[self.root].copy()
+
+    def lowest_z(self) -> float:
+        """Height (m) of the figure's lowest surface point."""
+        pts, gid, rad = self._probe
+        d = self.data
+        R = d.geom_xmat[gid].reshape(-1, 3, 3)
+        z = d.geom_xpos[gid, 2] + np.einsum("pj,pj->p", R[:, 2, :], pts) - rad
+        return float(z.min())
+
+    def segment_wrenches(self) -> np.ndarray:
+        """(17,6) external force (N) and torque about the segment's centre of mass (N m) other
+        systems applied to each segment in the last coupling step."""
+        return self.data.xfrc_applied[self.seg_body].copy()
+
+    def health(self):
+        d = self.data
+        if not (math.isfinite(d.qpos.sum()) and math.isfinite(d.qvel.sum())):
+            return [f"{self.name}: state became non-finite at t={self.time:.4f} s"]
+        return []
+
+    # --- state -------------------------------------------------------------------------------
+    def generalized_state(self):
+        """(qpos, qpos rate); buffers are reused: copy them to keep them."""
+        d = self.data
+        self._gx[:] = d.qpos
+        if self.free:
+            self._gv[:3] = d.qvel[:3]
+            self._gv[3:7] = 0.5 * _qmul(d.qpos[3:7], np.concatenate([[0.0], d.qvel[3:6]]))
+            self._gv[7:] = d.qvel[6:]
+        else:
+            self._gv[:] = d.qvel
+        return self._gx, self._gv
+
+    def set_generalized_state(self, x, xdot):
+        d = self.data
+        d.qpos[:] = x
+        if self.free:
+            q = np.asarray(x[3:7], dtype=float)
+            q = q / np.linalg.norm(q)
+            d.qpos[3:7] = q
+            d.qvel[:3] = xdot[:3]
+            # body-frame angular velocity: w = 2 conj(q) qdot (vector part)
+            d.qvel[3:6] = 2.0 * _qmul(q * [1.0, -1.0, -1.0, -1.0], xdot[3:7])[1:]
+            d.qvel[6:] = xdot[7:]
+        else:
+            d.qvel[:] = xdot
+        self._mj.mj_forward(self.model, d)
+
+    def capture(self):
+        d = self.data
+        snap = {k: getattr(d, k).copy() for k in ("qpos", "qvel", "ctrl", "qacc_warmstart")}
+        snap.update(time=np.array(self.time), next_control=np.array(self._next_control),
+                    targets=self.targets.copy(), vtargets=self.vtargets.copy(),
+                    omega=self.omega.copy(), zeta=self.zeta.copy(),
+                    fsm=np.array([self.fsm.current if self.fsm else 0,
+                                  self.fsm.entered if self.fsm else 0.0]),
+                    support=np.array(self.support), balance=np.array(self.balance_offset),
+                    blend=np.zeros(0) if self._blend is None else np.concatenate(
+                        [self._blend[0], self._blend[1], self._blend[2:]]))
+        return snap
+
+    def restore(self, snap):
+        d = self.data
+        for k in ("qpos", "qvel", "ctrl", "qacc_warmstart"):
+            getattr(d, k)[:] = snap[k]
+        self.time = float(snap["time"])
+        self._next_control = float(snap["next_control"])
+        self.targets[:], self.vtargets[:] = snap["targets"], snap["vtargets"]
+        self.omega[:], self.zeta[:] = snap["omega"], snap["zeta"]
+        if self.fsm is not None:
+            self.fsm.current, self.fsm.entered = int(snap["fsm"][0]), float(snap["fsm"][1])
+        self.support = bool(snap["support"])
+        self.balance_offset = float(snap["balance"])
+        b, n = snap["blend"], len(self.targets)
+        self._blend = None if len(b) == 0 else (b[:n].copy(), b[n:2 * n].copy(), b[-2], b[-1])
+        self.apply_gains()
+        self._set_ctrl()
+        self._mj.mj_forward(self.model, d)
+
+    def frame(self):
+        d = self.data
+        return {"segment_positions": d.xpos[self.seg_body].copy(),
+                "segment_orientations": d.xquat[self.seg_body].copy(),
+                "segment_wrenches": d.xfrc_applied[self.seg_body].copy(),
+                "com": d.subtree_com[self.root].copy()}
+
+    # --- geometry ----------------------------------------------------------------------------
+    def segment_meshes(self) -> list:
+        """Per segment (vertices (n,3) m in the segment frame, triangles (m,3))."""
+        return [segment_mesh(s.shape) for s in self.plan]
+
+    def surface(self):
+        """The whole figure's triangle surface at the current pose: vertices (n,3) m and
+        triangles (m,3)."""
+        d = self.data
+        verts, tris, base = [], [], 0
+        for k, (v, t) in enumerate(self.segment_meshes()):
+            b = self.seg_body[k]
+            verts.append(d.xpos[b] + v @ d.xmat[b].reshape(3, 3).T)
+            tris.append(t + base)
+            base += len(v)
+        return np.concatenate(verts), np.concatenate(tris)
