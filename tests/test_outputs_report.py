@@ -86,6 +86,7 @@ def test_compare_writes_side_by_side_video_and_report(tmp_path, capsys):
     assert {"video", "height", "modes", "advice", "runs"} <= rep.ids
     assert_links_resolve(tmp_path / "report.html", rep)
     assert sum("report.html" in link for link in rep.links) == 3
+    assert "paper: ball / net" in (tmp_path / "report.html").read_text()
     assert json.loads((tmp_path / "compare.json").read_text())["scene"] == "basketball"
 
 

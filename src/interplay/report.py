@@ -218,12 +218,13 @@ def _slug(name) -> str:
 
 
 def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=None,
-                         mode_reports: dict | None = None, files: dict | None = None
-                         ) -> list[Path]:
+                         mode_reports: dict | None = None, files: dict | None = None,
+                         pair: tuple | None = None) -> list[Path]:
     """Write the compare report (report.html) into out_dir: the modes side by side.
 
     runs: {mode: RunData}; rows: {mode: compare row (report_text.mode_row)}; advice: the
-    advisor's verdict with the measurements of all modes; mode_reports: {mode: report path}.
+    advisor's verdict with the measurements of all modes; mode_reports: {mode: report path};
+    pair: (primary, secondary) names of the compared interaction, for the paper's Table I row.
     """
     from .render.plots import height_plot, primary_height
     out = Path(out_dir)
@@ -253,16 +254,14 @@ def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=No
         line("warnings", lambda r: str(len(r["warnings"]))),
     ])
     ref_rows = []
-    for m in modes:
-        it = runs[m]
-        for key, ref in PAPER_TABLE_I.items():
-            if key[0] == it.primary and not ref_rows:
-                ref_rows.append([f"paper: {key[0]} / {key[1]}",
-                                 " / ".join(f"{v:.1f}" for v in ref["force_N"]),
-                                 " / ".join(f"{v:.2f}" for v in ref["acceleration_m_s2"])])
-    ref = (_table(["Table I reference", "force min / max / mean (N)",
-                   "accel. min / max / mean (m/s²)"], ref_rows, ["paper"] * len(ref_rows))
-           if ref_rows else "")
+    ref = PAPER_TABLE_I.get(tuple(pair)) if pair else None
+    if ref:
+        ref_rows.append([f"paper: {pair[0]} / {pair[1]}",
+                         " / ".join(f"{v:.1f}" for v in ref["force_N"]),
+                         " / ".join(f"{v:.2f}" for v in ref["acceleration_m_s2"])])
+    ref_html = (_table(["Table I reference", "force min / max / mean (N)",
+                        "accel. min / max / mean (m/s²)"], ref_rows, ["paper"] * len(ref_rows))
+                if ref_rows else "")
     reports = "".join(f'<li><a href="{_e(_rel(p, out))}">{_e(m)}</a>: its own report '
                       "(force plots, windows, timings, files)</li>"
                       for m, p in (mode_reports or {}).items())
@@ -271,7 +270,7 @@ def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=No
     sections = [
         ("video", "The modes side by side", _video(video, out, " | ".join(modes))),
         ("height", "Primary height over time", plot_html or "<p>No primary recorded.</p>"),
-        ("modes", "Measured figures per mode", table + ref + warns),
+        ("modes", "Measured figures per mode", table + ref_html + warns),
         ("advice", "Coupling advice (the paper's Figure 17)", _advice(advice)),
         ("runs", "Per-mode reports", f"<ul>{reports}</ul>"),
         ("files", "Files", _files(files or {}, out)),
