@@ -109,7 +109,8 @@ class BodyInWater(Interaction):
         body, water, p = self.primary, self.secondary, self.p
         if hasattr(body, "ellipsoid"):
             self._set_rotation(body.ellipsoid()[1])
-        lids = water.add_ellipsoid(body.x, self._A, self._M, self.volume, keep=to_secondary)
+        lids = water.add_ellipsoid(body.x, float(body.v[2]), self._A, self._M, self.volume,
+                                   keep=to_secondary)
         out = water.body_load(lids, self._out)
         vsub = out[0]
         acc = (body.v - self._v_prev) / self._h if self._h > 0.0 else self._zero

@@ -53,23 +53,31 @@ def _content(H, b, lo, chord, kappa):
     return H - b - chord, 1.0
 
 
+@njit(cache=True, inline="always")
+def _lid_sample(zlo, zhi, scale, b):
+    """Bottom (m, not below the bed b) and volume-scaled chord (m) of a lid's sample."""
+    lo = max(zlo, b)
+    return lo, scale * max(zhi - lo, 0.0)
+
+
 @njit(cache=True)
-def lid_level(eta, b, lo, chord, kappa):
+def lid_level(eta, b, zlo, zhi, scale, kappa):
     """The head H (m) of a column under a body: the root of mean_s C_s(H) = eta - b (its
     water), a monotone piecewise-linear equation solved by Newton's method kept inside a
     bracket (exact once on the right linear piece)."""
-    ns2 = lo.shape[0]
+    ns2 = zlo.shape[0]
     target = eta - b
     cmax = 0.0
     for s in range(ns2):
-        cmax = max(cmax, chord[s])
+        cmax = max(cmax, _lid_sample(zlo[s], zhi[s], scale, b)[1])
     a, z = eta, eta + cmax * (1.0 + 1.0 / kappa) + 1e-12
     H = eta
     for _ in range(60):
         c = 0.0
         dc = 0.0
         for s in range(ns2):
-            ci, di = _content(H, b, lo[s], chord[s], kappa)
+            lo, ch = _lid_sample(zlo[s], zhi[s], scale, b)
+            ci, di = _content(H, b, lo, ch, kappa)
             c += ci
             dc += di
         f = c / ns2 - target
@@ -85,11 +93,11 @@ def lid_level(eta, b, lo, chord, kappa):
 
 
 @njit(cache=True)
-def heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H):
+def heads(V, bed, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext, eta, H):
     """Fill the surface eta, the external pressure head ext and the pressure head H (m).
 
     Bodies are given as *lids*: a column (flat index) with, at each of its sample points, the
-    bottom lo (m, not below the bed) and the length (m) of the body's vertical chord. Within a
+    bottom and top (m) of the body's vertical chord, and a volume scale. Within a
     column the water is hydrostatic: the free part stands at H, the part under the body is
     held down by the pressure the body exerts (``_content``). ext = H - eta is the body's
     pressure head; it is a function of the water's own state, so the coupling stores and
@@ -105,7 +113,8 @@ def heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H):
     for k in range(n_lid):
         c = lid_cell[k]
         i, j = c // ny, c % ny
-        ext[i, j] += lid_level(eta[i, j], bed[i, j], lid_lo[k], lid_chord[k], kappa) - eta[i, j]
+        ext[i, j] += lid_level(eta[i, j], bed[i, j], lid_zlo[k], lid_zhi[k], lid_scale[k],
+                               kappa) - eta[i, j]
     for i in range(nx):
         for j in range(ny):
             H[i, j] = eta[i, j] + ext[i, j]
@@ -147,14 +156,17 @@ def column_velocity(Q, V, pipe, i, j, area, w):
 
 
 @njit(cache=True)
-def flow_step(V, Q, bed, pipe, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, l, g, w,
-              damping, dt, eta, H, out, rate):
+def flow_step(V, Q, bed, pipe, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext,
+              l, g, w, damping, body_damping, dt, eta, H, out, rate):
     """One step of the volume model: flows, outflow limiting, volumes. ``rate`` receives the
     surface's vertical speed dV/dt / l^2 (m/s). Every pipe moves the same volume out of one
     column and into the other, so the total is conserved to round-off."""
     nx, ny = V.shape
-    heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H)
+    heads(V, bed, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext, eta, H)
     keep = 1.0 / (1.0 + damping * dt)  # implicit linear pipe friction (1/s)
+    # under a body the penalty makes a stiff, light cavity whose trapped waves nothing would
+    # damp; the body's wetted surface does (a viscous boundary layer): body_damping (1/s)
+    keep_body = 1.0 / (1.0 + (damping + body_damping) * dt)
     for k in range(4):
         di, dj = _dir(k)
         coef = dt * w * g / (l * (SQRT2 if k >= 2 else 1.0))
@@ -165,7 +177,8 @@ def flow_step(V, Q, bed, pipe, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, 
                 a, b = i + di, j + dj
                 sill = max(eta[i, j], eta[a, b]) - max(bed[i, j], bed[a, b])
                 if sill > 0.0:
-                    Q[k, i, j] = (Q[k, i, j] + coef * sill * (H[i, j] - H[a, b])) * keep
+                    kk = keep_body if ext[i, j] > 0.0 or ext[a, b] > 0.0 else keep
+                    Q[k, i, j] = (Q[k, i, j] + coef * sill * (H[i, j] - H[a, b])) * kk
                 else:
                     Q[k, i, j] = 0.0
     # outflow limiting: a column never gives more than it holds
@@ -210,53 +223,52 @@ def flow_step(V, Q, bed, pipe, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, 
             rate[i, j] = (V[i, j] - rate[i, j]) * inv
 
 
-@njit(cache=True, inline="always")
-def _surface_at(px, py, x0, y0, l, fluid, field, nx, ny):
-    """Bilinear interpolation of a column field at (px, py) over fluid columns only."""
+@njit(cache=True)
+def _surface_velocity(px, py, x0, y0, l, fluid, Q, V, pipe, rate, area, w):
+    """The surface's velocity (m/s) at (px, py): bilinear over the four nearest fluid
+    columns of their flow velocity and the surface's vertical speed."""
+    nx, ny = V.shape
     fx = (px - x0) / l
     fy = (py - y0) / l
     i0 = min(max(int(math.floor(fx)), 0), nx - 2)
     j0 = min(max(int(math.floor(fy)), 0), ny - 2)
     tx = min(max(fx - i0, 0.0), 1.0)
     ty = min(max(fy - j0, 0.0), 1.0)
-    s = 0.0
-    wsum = 0.0
+    sx = sy = sz = wsum = 0.0
     for a in range(2):
         for b in range(2):
             if fluid[i0 + a, j0 + b]:
                 wt = (tx if a else 1.0 - tx) * (ty if b else 1.0 - ty)
-                s += wt * field[i0 + a, j0 + b]
+                u, v = column_velocity(Q, V, pipe, i0 + a, j0 + b, area, w)
+                sx += wt * u
+                sy += wt * v
+                sz += wt * rate[i0 + a, j0 + b]
                 wsum += wt
-    return s / wsum if wsum > 0.0 else 0.0
+    if wsum <= 0.0:
+        return 0.0, 0.0, 0.0
+    return sx / wsum, sy / wsum, sz / wsum
 
 
 @njit(cache=True)
-def emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold, fraction, vp, px,
-               pv, count, dt, ux, uy):
+def emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold, fraction, vp, radius,
+               px, pv, count, dt):
     """Emit particles where the surface rises faster than ``threshold`` (m/s): the expected
     number from a column is fraction * l^2 (rate - threshold) dt / vp, rounded stochastically,
     placed uniformly over the column at its surface with the surface's interpolated velocity.
-    Each particle's volume vp (m^3) leaves its column. Returns the new particle count."""
+    Each particle's volume vp (m^3, radius m) leaves its column; columns shallower than four
+    radii do not spray. Returns the new particle count."""
     nx, ny = V.shape
     cap = px.shape[0]
     n = count
-    emitting = False
     for i in range(nx):
         for j in range(ny):
-            if fluid[i, j] and rate[i, j] > threshold:
-                emitting = True
-    if not emitting:
-        return n
-    for i in range(nx):
-        for j in range(ny):
-            ux[i, j], uy[i, j] = column_velocity(Q, V, pipe, i, j, area, w)
-    for i in range(nx):
-        for j in range(ny):
+            r = rate[i, j]
+            # a film a few drops deep (a wetting beach) flickers fast but has nothing to throw
+            if r <= threshold or not fluid[i, j] \
+                    or V[i, j] / area < 4.0 * radius:
+                continue
             if n >= cap:
                 return n
-            r = rate[i, j]
-            if not fluid[i, j] or r <= threshold:
-                continue
             k = int(fraction * area * (r - threshold) * dt / vp + np.random.random())
             k = min(k, int(V[i, j] / vp), cap - n)
             for _ in range(k):
@@ -265,19 +277,39 @@ def emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold, fracti
                 px[n, 0] = x
                 px[n, 1] = y
                 px[n, 2] = H[i, j]
-                pv[n, 0] = _surface_at(x, y, x0, y0, l, fluid, ux, nx, ny)
-                pv[n, 1] = _surface_at(x, y, x0, y0, l, fluid, uy, nx, ny)
-                pv[n, 2] = _surface_at(x, y, x0, y0, l, fluid, rate, nx, ny)
+                pv[n, 0], pv[n, 1], pv[n, 2] = _surface_velocity(x, y, x0, y0, l, fluid, Q, V,
+                                                                 pipe, rate, area, w)
                 V[i, j] -= vp
                 n += 1
     return n
 
 
+@njit(cache=True, inline="always")
+def _land(V, fluid, i, j, vp):
+    """Return a landed particle's volume vp to column (i, j) and its fluid neighbours
+    (weights 4 / 2 / 1 for centre / side / corner): a drop's volume in one column would be a
+    one-column bump whose collapse rises faster than the spray threshold and sprays again."""
+    nx, ny = V.shape
+    wsum = 0.0
+    for a in range(max(i - 1, 0), min(i + 2, nx)):
+        for b in range(max(j - 1, 0), min(j + 2, ny)):
+            if fluid[a, b]:
+                wsum += 4.0 / ((1 + abs(a - i)) * (1 + abs(b - j)))
+    left = vp
+    for a in range(max(i - 1, 0), min(i + 2, nx)):
+        for b in range(max(j - 1, 0), min(j + 2, ny)):
+            if fluid[a, b] and not (a == i and b == j):
+                part = vp * 4.0 / ((1 + abs(a - i)) * (1 + abs(b - j))) / wsum
+                V[a, b] += part
+                left -= part
+    V[i, j] += left  # the remainder, so exactly vp is returned
+
+
 @njit(cache=True)
 def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp, dt):
     """Ballistic flight with quadratic air drag (a = g - drag |v| v, drag in 1/m). A particle
-    that falls to the surface (or onto a wall) gives its volume to the fluid column below it
-    (the nearest fluid column, off the water). Returns the new count."""
+    that falls to the surface (or onto a wall) gives its volume back around the fluid column
+    below it (the nearest fluid column, off the water). Returns the new count."""
     nx, ny = V.shape
     n = count
     p = 0
@@ -293,7 +325,7 @@ def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp,
         ground = H[i, j] if fluid[i, j] else bed[i, j]
         if pv[p, 2] < 0.0 and px[p, 2] <= ground:
             t = nearest[i, j]
-            V[t // ny, t % ny] += vp
+            _land(V, fluid, t // ny, t % ny, vp)
             n -= 1
             for c in range(3):
                 px[p, c] = px[n, c]
@@ -304,12 +336,13 @@ def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp,
 
 
 @njit(cache=True)
-def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_lo, lid_chord, n_lid, kappa,
-            ext, x0, y0, l, g, w, damping, h, dt_max, cfl, eta, H, out, rate, spray_on,
-            threshold, fraction, vp, drag, px, pv, count, seed, ux, uy, track):
+def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_zlo, lid_zhi, lid_scale,
+            lid_vz, n_lid, kappa, ext, x0, y0, l, g, w, damping, body_damping, h, dt_max, cfl, eta,
+            H, out, rate, spray_on, threshold, fraction, vp, radius, drag, px, pv, count, seed, track):
     """Advance the water h seconds in equal substeps no longer than dt_max or the wave-speed
     limit cfl * l / sqrt(g d_max (1 + kappa if bodies touch it)), rechecked each coupling
-    step; the bodies' lids are held. track = [peak particle count, min depth (m)] is updated
+    step; the bodies' lids move on at their vertical speeds (a lid held still for the step and
+    jumping at its end would hit the water with pressure spikes of kappa v h). track = [peak particle count, min depth (m)] is updated
     in place. Returns (particle count, substeps taken)."""
     dmax = max_depth(V, fluid, area)
     stiff = 1.0 + kappa if n_lid > 0 else 1.0
@@ -319,20 +352,23 @@ def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_lo, lid_chord, 
     np.random.seed(seed)  # counter-based seeding: a rerun from a capture repeats the spray
     nx, ny = V.shape
     for _ in range(nsub):
-        flow_step(V, Q, bed, pipe, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, l, g,
-                  w, damping, dt, eta, H, out, rate)
-        if spray_on:
-            heads(V, bed, area, lid_cell, lid_lo, lid_chord, n_lid, kappa, ext, eta, H)
+        flow_step(V, Q, bed, pipe, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa,
+                  ext, l, g, w, damping, body_damping, dt, eta, H, out, rate)
+        if spray_on:  # H is the substep's start: spray leaves and lands on it
             count = emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold,
-                               fraction, vp, px, pv, count, dt, ux, uy)
+                               fraction, vp, radius, px, pv, count, dt)
             count = move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag,
                                vp, dt)
+        for k in range(n_lid):  # the bodies move on within the coupling step
+            for s in range(lid_zlo.shape[1]):
+                lid_zlo[k, s] += lid_vz[k] * dt
+                lid_zhi[k, s] += lid_vz[k] * dt
         if count > track[0]:
             track[0] = count
-        for i in range(nx):
-            for j in range(ny):
-                if fluid[i, j] and V[i, j] / area < track[1]:
-                    track[1] = V[i, j] / area
+    for i in range(nx):
+        for j in range(ny):
+            if fluid[i, j] and V[i, j] / area < track[1]:
+                track[1] = V[i, j] / area
     return count, nsub
 
 
@@ -380,21 +416,20 @@ def _chord(c, A, x, y):
 
 
 @njit(cache=True)
-def add_ellipsoid(c, A, M, full_volume, bed, fluid, x0, y0, l, ns, lid_cell, lid_lo,
-                  lid_chord, n):
+def add_ellipsoid(c, vz, A, M, full_volume, fluid, x0, y0, l, ns, lid_cell, lid_zlo, lid_zhi,
+                  lid_scale, lid_vz, n):
     """Append the lids of the ellipsoid {p : (p - c)^T A (p - c) <= 1} (M = A^-1: its
-    horizontal half extents are sqrt(M00), sqrt(M11)) from index n: one per fluid column its
-    shadow touches, sampled at ns x ns points; chords are clipped at the bed (no water below
-    it) and scaled by full_volume / (sampled volume) so the sampled body has its exact volume.
-    Returns the new count, or -1 if the buffers are too small."""
-    nx, ny = bed.shape
+    horizontal half extents are sqrt(M00), sqrt(M11)) moving up at vz (m/s) from index n: one
+    per fluid column its shadow touches, sampled at ns x ns points. The scale full_volume /
+    (sampled volume) gives the sampled body its exact volume. Returns the new count, or -1
+    if the buffers are too small."""
+    nx, ny = fluid.shape
     ex = math.sqrt(M[0, 0])
     ey = math.sqrt(M[1, 1])
     i_lo = int(math.floor((c[0] - ex - x0) / l + 0.5))
     i_hi = int(math.floor((c[0] + ex - x0) / l + 0.5))
     j_lo = int(math.floor((c[1] - ey - y0) / l + 0.5))
     j_hi = int(math.floor((c[1] + ey - y0) / l + 0.5))
-    da = 1.0 / (ns * ns)
     sampled = 0.0
     start = n
     for i in range(i_lo, i_hi + 1):
@@ -407,38 +442,32 @@ def add_ellipsoid(c, A, M, full_volume, bed, fluid, x0, y0, l, ns, lid_cell, lid
                 x = x0 + (i - 0.5 + (si + 0.5) / ns) * l
                 for sj in range(ns):
                     zlo, zhi = _chord(c, A, x, y0 + (j - 0.5 + (sj + 0.5) / ns) * l)
-                    s = si * ns + sj
                     if zhi <= zlo:
-                        if inside:
-                            lid_lo[n, s] = 0.0
-                            lid_chord[n, s] = 0.0
-                        continue
-                    sampled += (zhi - zlo) * da * l * l
+                        zlo = zhi = -1e30  # no body here: a chord of zero length
+                    else:
+                        sampled += (zhi - zlo) * l * l / (ns * ns)
+                        touched = True
                     if inside:
-                        lo = max(zlo, bed[i, j])
-                        lid_lo[n, s] = lo
-                        lid_chord[n, s] = max(zhi - lo, 0.0)
-                        touched = touched or zhi > lo
+                        lid_zlo[n, si * ns + sj] = zlo
+                        lid_zhi[n, si * ns + sj] = zhi
             if inside and touched:
                 lid_cell[n] = i * ny + j
+                lid_vz[n] = vz
                 n += 1
-    if sampled > 0.0:
-        scale = full_volume / sampled
-        for k in range(start, n):
-            for s in range(ns * ns):
-                lid_chord[k, s] *= scale
+    for k in range(start, n):
+        lid_scale[k] = full_volume / sampled
     return n
 
 
 @njit(cache=True)
-def lid_load(V, Q, pipe, bed, area, rate, lid_cell, lid_lo, lid_chord, start, stop, kappa,
-             x0, y0, l, w, out):
+def lid_load(V, Q, pipe, bed, area, rate, lid_cell, lid_zlo, lid_zhi, lid_scale, start, stop,
+             kappa, x0, y0, l, w, out):
     """What the water does to the body whose lids are [start, stop): out = [displaced volume
     (m^3: the sum of pressure head times column area, so rho g out[0] is the force), centre of
     buoyancy (3) m, water velocity (3) m/s]; the velocity is load-weighted, horizontal from the
-    flows, vertical the surface's."""
+    flows, vertical the surface's scaled by the height above the bed."""
     nx, ny = V.shape
-    ns2 = lid_lo.shape[1]
+    ns2 = lid_zlo.shape[1]
     ns = int(round(math.sqrt(ns2)))
     out[:] = 0.0
     tot = 0.0
@@ -447,24 +476,27 @@ def lid_load(V, Q, pipe, bed, area, rate, lid_cell, lid_lo, lid_chord, start, st
         i, j = cell // ny, cell % ny
         b = bed[i, j]
         e = b + V[i, j] / area
-        H = lid_level(e, b, lid_lo[k], lid_chord[k], kappa)
+        H = lid_level(e, b, lid_zlo[k], lid_zhi[k], lid_scale[k], kappa)
         col = 0.0
         for s in range(ns2):
-            c, _ = _content(H, b, lid_lo[k, s], lid_chord[k, s], kappa)
+            lo, ch = _lid_sample(lid_zlo[k, s], lid_zhi[k, s], lid_scale[k], b)
+            c, _ = _content(H, b, lo, ch, kappa)
             head = H - b - c  # what the body keeps out of this sample (m)
             if head <= 0.0:
                 continue
             dv = head * area / ns2
+            zc = lo + 0.5 * head
             col += dv
             out[1] += dv * (x0 + (i - 0.5 + (s // ns + 0.5) / ns) * l)
             out[2] += dv * (y0 + (j - 0.5 + (s % ns + 0.5) / ns) * l)
-            out[3] += dv * (lid_lo[k, s] + 0.5 * head)
+            out[3] += dv * zc
+            # shallow water: the vertical velocity grows linearly from the bed to the surface
+            out[6] += dv * rate[i, j] * min(max((zc - b) / max(H - b, 1e-9), 0.0), 1.0)
         if col > 0.0:
             tot += col
             u, v = column_velocity(Q, V, pipe, i, j, area, w)
             out[4] += col * u
             out[5] += col * v
-            out[6] += col * rate[i, j]
     if tot > 0.0:
         for r in range(1, 7):
             out[r] /= tot

@@ -10,6 +10,8 @@ REGISTRY = {
     "basketball": ("basketball", "a basketball falls through a spring-mass net (two-way, "
                                  "one-way or hybrid)"),
     "flags": ("flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)"),
+    "pond": ("pond", "balls of different densities float, bob and sink in a pond (two-way)"),
+    "puddle": ("puddle", "a keyframed foot steps in a shallow puddle and splashes it (one-way)"),
 }
 
 

@@ -47,7 +47,8 @@ class WaterParams:
     body_stiffness kappa (-): pressure head per metre of water rising into a body. A floating
     body rests deeper than Archimedes by about 1/(1 + kappa) of its submerged depth; while a
     body touches the water the substeps shrink by sqrt(1 + kappa). body_samples: sample points
-    per column side where a body cuts the columns."""
+    per column side where a body cuts the columns. body_damping (1/s): extra pipe friction
+    under a body (its wetted surface), which damps waves trapped under it."""
     density: float = 1000.0  # kg/m^3
     gravity: float = 9.81  # m/s^2
     damping: float = 0.5  # 1/s
@@ -55,6 +56,7 @@ class WaterParams:
     dt: float = 0.0  # s, 0 = automatic
     body_stiffness: float = 30.0
     body_samples: int = 4
+    body_damping: float = 200.0  # 1/s
     spray: SprayParams = SprayParams()
 
 
@@ -93,6 +95,7 @@ class Water(System):
         self.g = require_positive(name, "gravity", p.gravity, "m/s^2")
         require_nonnegative(name, "damping", p.damping, "1/s")
         self.kappa = require_positive(name, "body_stiffness", p.body_stiffness)
+        require_nonnegative(name, "body_damping", p.body_damping, "1/s")
         self.samples = int(p.body_samples)
         if self.samples < 1:
             raise ParameterError(f"{name}: body_samples must be >= 1, got {p.body_samples}")
@@ -154,8 +157,6 @@ class Water(System):
         self._eta = np.zeros(bed.shape)
         self._H = np.zeros(bed.shape)
         self._work = np.zeros(bed.shape)
-        self._ux = np.zeros(bed.shape)
-        self._uy = np.zeros(bed.shape)
         self._em = np.zeros(4)
 
     # --- the System protocol -----------------------------------------------------------------
@@ -170,22 +171,26 @@ class Water(System):
     def _grow_lids(self, cap):
         s2 = self.samples * self.samples
         old = getattr(self, "n_lid", 0)
-        cell, lo, chord = np.zeros(cap, np.int64), np.zeros((cap, s2)), np.zeros((cap, s2))
+        arrays = (np.zeros(cap, np.int64), np.zeros((cap, s2)), np.zeros((cap, s2)),
+                  np.zeros(cap), np.zeros(cap))
         if old:
-            cell[:old], lo[:old], chord[:old] = (self.lid_cell[:old], self.lid_lo[:old],
-                                                 self.lid_chord[:old])
-        self.lid_cell, self.lid_lo, self.lid_chord, self.n_lid = cell, lo, chord, old
+            for new, cur in zip(arrays, self._lids()):
+                new[:old] = cur[:old]
+        self.lid_cell, self.lid_zlo, self.lid_zhi, self.lid_scale, self.lid_vz = arrays
+        self.n_lid = old
+
+    def _lids(self):
+        return self.lid_cell, self.lid_zlo, self.lid_zhi, self.lid_scale, self.lid_vz
 
     def _run(self, h, dt_max):
         s = self.params.spray
         self.count, _ = K.advance(
             self.V, self.Q, self.bed, self.pipe, self.fluid, self.nearest, self.area,
-            self.lid_cell, self.lid_lo, self.lid_chord, self.n_lid, self.kappa, self.ext,
+            *self._lids(), self.n_lid, self.kappa, self.ext,
             self.origin[0], self.origin[1], self.spacing, self.g, self.pipe_width,
-            self.params.damping, h, dt_max, self.params.cfl, self._eta, self._H, self._work,
-            self.rate, self.spray_on, s.threshold, s.fraction, self.particle_volume,
-            self.air_drag, self.px, self.pv, self.count, self._steps & 0xFFFFFFFF, self._ux,
-            self._uy, self._track)
+            self.params.damping, self.params.body_damping, h, dt_max, self.params.cfl, self._eta, self._H, self._work,
+            self.rate, self.spray_on, s.threshold, s.fraction, self.particle_volume, s.radius,
+            self.air_drag, self.px, self.pv, self.count, self._steps & 0xFFFFFFFF, self._track)
         self._steps += 1
 
     def step(self, h):
@@ -204,8 +209,8 @@ class Water(System):
     def heights(self) -> np.ndarray:
         """(nx, ny) surface heights (m): bed + depth + external pressure head (the water
         pushed up around a body)."""
-        K.heads(self.V, self.bed, self.area, self.lid_cell, self.lid_lo, self.lid_chord,
-                self.n_lid, self.kappa, self.ext, self._eta, self._H)
+        K.heads(self.V, self.bed, self.area, *self._lids()[:4], self.n_lid, self.kappa,
+                self.ext, self._eta, self._H)
         return self._H.copy()
 
     def column_centres(self):
@@ -304,17 +309,17 @@ class Water(System):
         self.time = float(snap["time"])
 
     # --- bodies --------------------------------------------------------------------------------
-    def add_ellipsoid(self, centre, A, M, volume, keep=True):
-        """Register the body {p: (p-c)^T A (p-c) <= 1} (M = A^-1, volume in m^3) for this
-        coupling step: where it cuts the columns, water rising into it meets external
-        pressure. Returns the (start, stop) range of its lids for ``body_load``; keep=False
-        measures without pressing on the water (the range is then valid until the next
-        call)."""
+    def add_ellipsoid(self, centre, vz, A, M, volume, keep=True):
+        """Register the body {p: (p-c)^T A (p-c) <= 1} (M = A^-1, volume in m^3), moving up
+        at vz (m/s), for this coupling step: where it cuts the columns, water rising into it
+        meets external pressure. Returns the (start, stop) range of its lids for
+        ``body_load``; keep=False measures without pressing on the water (the range is then
+        valid until the next call)."""
         start = self.n_lid
         while True:
-            n = K.add_ellipsoid(centre, A, M, volume, self.bed, self.fluid, self.origin[0],
-                                self.origin[1], self.spacing, self.samples, self.lid_cell,
-                                self.lid_lo, self.lid_chord, start)
+            n = K.add_ellipsoid(centre, vz, A, M, volume, self.fluid, self.origin[0],
+                                self.origin[1], self.spacing, self.samples, *self._lids()[:4],
+                                self.lid_vz, start)
             if n >= 0:
                 break
             self._grow_lids(2 * self.lid_cell.shape[0])
@@ -326,8 +331,9 @@ class Water(System):
         """The water's push on a body from its lids (``add_ellipsoid``): out (7,) receives
         the displaced volume (m^3; rho g times it is the buoyancy), the centre of buoyancy (m)
         and the water's velocity there (m/s)."""
-        K.lid_load(self.V, self.Q, self.pipe, self.bed, self.area, self.rate, self.lid_cell,
-                   self.lid_lo, self.lid_chord, lids[0], lids[1], self.kappa, self.origin[0],
+        K.lid_load(self.V, self.Q, self.pipe, self.bed, self.area, self.rate,
+                   self.lid_cell, self.lid_zlo, self.lid_zhi,
+                   self.lid_scale, lids[0], lids[1], self.kappa, self.origin[0],
                    self.origin[1], self.spacing, self.pipe_width, out)
         return out
 

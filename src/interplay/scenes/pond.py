@@ -1,0 +1,95 @@
+"""Balls floating in a pond (SPEC 4): rigid balls of different densities dropped into a small
+pond with a sloping shore, coupled two-way with the water: the light balls bob and float and
+drift on the waves they make, the dense one sinks to the bed with a larger splash.
+One-way drives the water with balls that fell through it unhindered; hybrid floats them on a
+still-water stand-in (buoyancy and drag below a flat surface) and then drives the water."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import ParameterError
+from ..geometry.basin import BasinParams, basin
+from ..interactions.buoyancy import BodyInWater, BuoyancyParams
+from ..interactions.contact import ContactParams, SpherePlaneContact
+from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
+from ..scene import Scene
+from ..systems.rigid import Sphere, SphereParams
+from ..systems.static import StaticPlane
+from ..systems.water import Water, WaterParams
+
+
+@dataclass(frozen=True)
+class BallsParams:
+    """The first ``count`` entries of each tuple: radius (m), density (kg/m^3; water is 1000),
+    x and y of the drop (m), drop height of the ball's bottom above the still surface (m).
+    dt: the balls' step (s)."""
+    count: int = 5
+    radius: tuple = (0.07, 0.06, 0.05, 0.065, 0.055)
+    density: tuple = (500.0, 300.0, 700.0, 850.0, 2500.0)
+    x: tuple = (-0.35, 0.3, -0.2, 0.35, 0.0)
+    y: tuple = (0.25, 0.3, -0.35, -0.2, 0.0)
+    height: tuple = (0.25, 0.4, 0.15, 0.3, 0.5)
+    dt: float = 1e-3  # s
+
+
+@dataclass(frozen=True)
+class PondParams:
+    basin: BasinParams = BasinParams(size_x=2.0, size_y=2.0, cells=128, depth=0.3, shore=0.3)
+    water: WaterParams = WaterParams()
+    balls: BallsParams = BallsParams()
+    buoyancy: BuoyancyParams = BuoyancyParams()
+    # the muddy flat bed at z = 0 under the sinking ball: stops it within ~1 cm, damping
+    # ratio ~0.7 for a 1.7 kg ball (a ball does not bounce off a pond's bed)
+    bed: ContactParams = ContactParams(stiffness=2.0e4, damping=250.0, friction=0.3, eps=0.05,
+                                       thickness=0.0)
+    # hybrid: still water at the basin's depth, damping fitted by eye to the two-way bobbing
+    field: ViscousDragFieldParams = ViscousDragFieldParams(linear=2.0, quadratic=20.0,
+                                                           density=1000.0)
+    coupling_dt: float = 2e-3  # s
+
+
+PARAMS = PondParams
+STANDIN = "field"
+
+
+def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
+          integrator: str | None = None, dt: float | None = None,
+          params: PondParams = PondParams()) -> Scene:
+    """The scene. dt overrides the water's largest step (s); the water has one integrator."""
+    if integrator is not None:
+        raise ParameterError(f"pond: --integrator {integrator} does not apply: the water has "
+                             "one integrator (virtual pipes); leave it out")
+    b, wp = params.balls, params.water
+    n = int(b.count)
+    for key in ("radius", "density", "x", "y", "height"):
+        if not 1 <= n <= len(getattr(b, key)):
+            raise ParameterError(f"pond: balls.count={n} but balls.{key} lists "
+                                 f"{len(getattr(b, key))} values; give one per ball")
+    if dt is not None:
+        from dataclasses import replace
+        wp = replace(wp, dt=dt)
+    geo = basin(params.basin)
+    scene = Scene("pond", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
+    water = scene.add(Water("water", geo.bed, geo.fluid, geo.depth, geo.spacing, geo.origin,
+                            wp))
+    floor = scene.add(StaticPlane("bed", height=0.0, size=0.5 * params.basin.size_x))
+    level = params.basin.depth
+    field = ViscousDragFieldParams(**{**params.field.__dict__, "surface": level,
+                                      "gravity": wp.gravity})
+    balls = []
+    for k in range(n):
+        r, rho = b.radius[k], b.density[k]
+        mass = rho * 4.0 / 3.0 * math.pi * r ** 3
+        ball = scene.add(Sphere(f"ball{k}", SphereParams(radius=r, mass=mass, shell=False,
+                                                         dt=b.dt),
+                                position=(b.x[k], b.y[k], level + b.height[k] + r)))
+        standin = ViscousDragField(field, r, 4.0 / 3.0 * math.pi * r ** 3)
+        scene.connect(BodyInWater(f"ball{k}-water", ball, water, params.buoyancy,
+                                  mode=coupling, standin=standin))
+        scene.connect(SpherePlaneContact(f"ball{k}-bed", ball, floor, params.bed))
+        balls.append(ball)
+    scene.primary = balls[0]
+    scene.checkpoints = {bl.name: [1.0, 2.0, 3.0] for bl in balls}
+    scene.meta = {"still_level": level, "densities": list(b.density[:n])}
+    return scene
