@@ -126,3 +126,17 @@ def test_unwritable_out_fails_before_simulating(tmp_path, capsys):
 def test_view_of_a_directory_without_a_run(tmp_path, capsys):
     code, out, err = run_cli(capsys, "view", str(tmp_path))
     assert code == 2 and err.count("\n") == 1 and "scene.json" in err
+
+
+def test_missing_gl_driver_fails_before_simulating(tmp_path, capsys, monkeypatch):
+    moderngl = pytest.importorskip("moderngl")
+    from interplay.render import gl
+
+    def no_egl(**kw):
+        raise Exception("libEGL.so.1: cannot open shared object file")
+    monkeypatch.setattr(gl, "_CTX", None)
+    monkeypatch.setattr(moderngl, "create_context", no_egl)
+    code, out, err = run_cli(capsys, "run", "basketball", "--out", str(tmp_path))
+    assert code == 2 and err.count("\n") == 1
+    assert "headless OpenGL" in err and "libegl-mesa0" in err and "--no-video" in err
+    assert not list(tmp_path.iterdir())

@@ -131,8 +131,8 @@ def cmd_run(args, console):
     module, kw = _build_kwargs(args)
     out = Path(args.out or f"out/{args.scene}")
     options = _outputs(args)
-    from .outputs import ensure_writable
-    ensure_writable(out)
+    from .outputs import preflight
+    preflight(out, options)
     result, paths = _run_one(module, args.coupling, kw, out, args.quiet, console, options)
     from .report_text import print_run
     print_run(console, result)

@@ -17,8 +17,8 @@ def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> 
     options: an outputs.OutputOptions to also write each mode's USD, OBJ, video and report,
     and the side-by-side video and compare report in out (None: summary and tracks only)."""
     if options is not None:
-        from .outputs import ensure_writable
-        ensure_writable(out)
+        from .outputs import preflight
+        preflight(out, options)
     results = {}
     for mode in MODES:
         if not quiet:

@@ -53,6 +53,25 @@ def ensure_writable(out_dir) -> Path:
     return d
 
 
+def preflight(out_dir, options: OutputOptions) -> Path:
+    """Fail fast, before simulating: the output directory must be writable and every
+    requested output's dependencies importable (and a headless GL context available for the
+    video). Each failure is one InterplayError naming the fix."""
+    d = ensure_writable(out_dir)
+    if options.usd:
+        from .io.usd import _pxr
+        _pxr()
+    if options.video:
+        from .render.gl import gl_context
+        from .render.video import _ffmpeg
+        gl_context()
+        _ffmpeg()
+    if options.report:
+        from .render.plots import _figure
+        _figure(1, 1)
+    return d
+
+
 class StepBar:
     """progress(done, total) for rendering and export: a rich bar that appears only when the
     task has run for more than a second (short tasks stay silent)."""
