@@ -140,3 +140,29 @@ def test_missing_gl_driver_fails_before_simulating(tmp_path, capsys, monkeypatch
     assert code == 2 and err.count("\n") == 1
     assert "headless OpenGL" in err and "libegl-mesa0" in err and "--no-video" in err
     assert not list(tmp_path.iterdir())
+
+
+def test_viewer_moves_every_system_with_the_slider(tmp_path, capsys):
+    pytest.importorskip("viser")
+    import socket
+    from interplay.io.scenefile import load_run
+    from interplay.viewer import Viewer
+    assert main(["run", "basketball", "--duration", "0.2", "--out", str(tmp_path), "--quiet",
+                 "--no-video", "--no-usd", "--no-obj", "--no-report"]) == 0
+    run = load_run(tmp_path)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    v = Viewer(run, port=port, log=lambda m: None)
+    try:
+        assert v.url == f"http://127.0.0.1:{port}"
+        last = len(run.times) - 1
+        v.set_frame(last)
+        kinds = {kind: h for kind, key, h in v.handles}
+        assert set(kinds) == {"pose", "segments"}
+        assert kinds["pose"].position == pytest.approx(tuple(run.pose("ball", last)[0]))
+        seg = run.shape("net").segments
+        assert kinds["segments"].points == pytest.approx(run.points("net", last)[seg], abs=1e-6)
+        assert v.clock.value == pytest.approx(run.times[last], abs=1e-3)
+    finally:
+        v.stop()
