@@ -10,6 +10,7 @@ REGISTRY = {
     "basketball": ("basketball", "a basketball falls through a spring-mass net (two-way, "
                                  "one-way or hybrid)"),
     "flags": ("flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)"),
+    "leaves": ("leaves", "a passing bicyclist's wake stirs up leaves that settle again (one-way)"),
     "pond": ("pond", "balls of different densities float, bob and sink in a pond (two-way)"),
     "puddle": ("puddle", "a keyframed foot steps in a shallow puddle and splashes it (one-way)"),
 }

@@ -1,0 +1,146 @@
+"""Leaves stirred by a passing bicyclist: a few dozen spring-mass leaves lie on the ground;
+a rider (a kinematic prop following a path) passes by; its wake, flow primitives riding along
+its path, lifts them; they flutter back down under gravity and drag and come to rest on the
+ground (penalty contact with friction). One-way: the air does not feel the leaves."""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import SceneError
+from ..geometry import shapes
+from ..interactions.aero import AeroParams, Aerodynamics
+from ..interactions.ground import GroundContact, GroundParams
+from ..scene import Scene
+from ..systems.path import Path, PathFollower
+from ..systems.springmass import SpringNetwork
+from ..systems.static import StaticPlane
+from ..systems.wind import FlowPrimitive, WindField
+
+
+@dataclass(frozen=True)
+class LeafParams:
+    """count leaves scattered with random yaw over the ground rectangle area = (x0, x1, y0, y1)
+    (m), seeded by seed; length, width (m), each scaled by 1 +- spread; stations, rows: the
+    leaf mesh (``shapes.leaf``); density (kg/m^2); stretch, shear, bend (N): stress/strain
+    ratios; vein: stiffness factor of the midrib; mass_damping (1/s), stiffness_damping (s);
+    dt (s), integrator, cg_tolerance of the leaves' simulation (one network for all)."""
+    count: int = 36
+    area: tuple = (-1.5, 1.5, -1.0, 1.0)
+    seed: int = 7
+    length: float = 0.10
+    width: float = 0.05
+    spread: float = 0.3
+    stations: int = 6
+    rows: int = 2
+    density: float = 0.12  # kg/m^2: a dry autumn leaf
+    stretch: float = 5.0
+    shear: float = 3.0
+    bend: float = 0.5
+    vein: float = 5.0
+    mass_damping: float = 0.2
+    stiffness_damping: float = 1e-4
+    dt: float = 1.0 / 240.0
+    integrator: str = "implicit"
+    cg_tolerance: float = 1e-5
+
+
+@dataclass(frozen=True)
+class RiderParams:
+    """The bicyclist rides along +x at y = 0 from start to end (m), passing x = 0 at
+    pass_time (s) at speed (m/s). Its wake rides along in its own frame (x forward, z up): the
+    low pressure behind the rider, a sink of `sink` (m^3/s) at (-behind, 0, height) m that
+    draws the leaves up after it, and a swirl about a vertical axis there (`swirl`, m^2/s),
+    both with core radius `core` (m) and gusting by `gust` (a turbulent wake)."""
+    speed: float = 5.5
+    pass_time: float = 1.0
+    start: float = -8.0
+    end: float = 12.0
+    behind: float = 0.8
+    height: float = 0.7
+    sink: float = 40.0
+    swirl: float = 3.0
+    core: float = 0.4
+    gust: float = 0.3
+    mass: float = 85.0  # kg, rider and bicycle: what the logged wake force is divided by
+
+
+@dataclass(frozen=True)
+class LeavesParams:
+    leaves: LeafParams = LeafParams()
+    rider: RiderParams = RiderParams()
+    aero: AeroParams = AeroParams()
+    # stiff enough that a leaf landing at its terminal ~1.3 m/s sinks ~1 mm (v / sqrt(k))
+    ground: GroundParams = GroundParams(stiffness=1.0e6, damping=1000.0)
+
+
+PARAMS = LeavesParams
+
+
+def scatter(p: LeafParams):
+    """(vertices, triangles, vein vertices) of p.count leaves lying flat on the ground."""
+    rng = np.random.default_rng(p.seed)
+    verts, tris, veins, n = [], [], [], 0
+    for _ in range(p.count):
+        s = 1.0 + p.spread * rng.uniform(-1.0, 1.0)
+        x, t, vein = shapes.leaf(p.length * s, p.width * s, p.stations, p.rows)
+        yaw = rng.uniform(0.0, 2.0 * np.pi)
+        c, si = np.cos(yaw), np.sin(yaw)
+        x = (x - [0.5 * p.length * s, 0.0, 0.0]) @ np.array([[c, -si, 0], [si, c, 0], [0, 0, 1]]).T
+        x += [rng.uniform(p.area[0], p.area[1]), rng.uniform(p.area[2], p.area[3]), 0.0]
+        verts.append(x)
+        tris.append(t + n)
+        veins.append(vein + n)
+        n += len(x)
+    return np.concatenate(verts), np.concatenate(tris), np.concatenate(veins)
+
+
+def rider_path(r: RiderParams) -> Path:
+    """Constant speed along +x through x = 0 at pass_time; straight lines keep PCHIP exact."""
+    ts = [r.pass_time + r.start / r.speed, r.pass_time, r.pass_time + r.end / r.speed]
+    return Path(ts, [[r.start, 0, 0], [0, 0, 0], [r.end, 0, 0]], name="rider path")
+
+
+def wake(r: RiderParams, path: Path) -> WindField:
+    """The rider's wake: flow primitives riding along its path. A sink decays as 1/r^2, so
+    only leaves the rider passes close to are lifted, and only while it is near."""
+    at = (-r.behind, 0.0, r.height)
+    common = dict(position=at, core=r.core, gust=r.gust, gust_period=0.4, path=path)
+    return WindField("wake", [FlowPrimitive("sink", strength=r.sink, **common),
+                              FlowPrimitive("vortex", axis=(0, 0, 1), strength=r.swirl,
+                                            phase=1.3, **common)])
+
+
+def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
+          integrator: str | None = None, dt: float | None = None,
+          params: LeavesParams = LeavesParams()) -> Scene:
+    """The scene; integrator and dt (s) override the leaves'. The wake ignores forces, so
+    one-way and two-way give the same motion; there is no stand-in for hybrid."""
+    if coupling == "hybrid":
+        raise SceneError("leaves: the wake has no stand-in (the air does not feel the leaves "
+                         "at all); use one-way")
+    lp = params.leaves
+    if integrator is not None:
+        lp = replace(lp, integrator=integrator)
+    if dt is not None:
+        lp = replace(lp, dt=dt)
+    scene = Scene("leaves", duration=duration, fps=fps)
+    path = rider_path(params.rider)
+    bv, bt = shapes.bicyclist()
+    rider = scene.add(PathFollower("bicyclist", path, bv, bt, mass=params.rider.mass,
+                                   dt=1.0 / fps))
+    air = scene.add(wake(params.rider, path))
+    x, t, vein = scatter(lp)
+    x[:, 2] = params.ground.thickness  # resting on the contact surface
+    area = 0.5 * np.linalg.norm(np.cross(x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]), axis=1)
+    leaves = scene.add(SpringNetwork.from_mesh(
+        "leaves", x, t, lp.density * area.sum(), lp.stretch, lp.shear, lp.bend,
+        stiffen=(vein, lp.vein), dt=lp.dt, integrator=lp.integrator,
+        mass_damping=lp.mass_damping, stiffness_damping=lp.stiffness_damping,
+        cg_tolerance=lp.cg_tolerance, strain_limit=0.5))
+    ground = scene.add(StaticPlane("ground", size=6.0))
+    scene.connect(Aerodynamics("wake-leaves", air, leaves, params.aero, mode="one-way"))
+    scene.connect(GroundContact("ground-leaves", ground, leaves, params.ground, mode="one-way"))
+    scene.primary = rider
+    return scene
