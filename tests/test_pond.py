@@ -1,0 +1,85 @@
+"""The pond and puddle scenes run end to end in every mode, with the water's diagnostics."""
+import json
+
+import numpy as np
+import pytest
+
+from interplay import params as P
+from interplay.cli import main
+from interplay.errors import ParameterError
+from interplay.scenes import load
+
+SMALL_POND = {"basin.cells": "40", "balls.count": "3"}
+
+
+def small(name, **sets):
+    m = load(name)
+    return m, P.apply(m.PARAMS(), sets)
+
+
+@pytest.mark.parametrize("mode", ["two-way", "one-way", "hybrid"])
+def test_pond_runs_in_every_mode(mode):
+    m, params = small("pond", **SMALL_POND)
+    scene = m.build(mode, duration=0.6, fps=20, params=params)
+    res = scene.simulate()
+    d = res.summary()["diagnostics"]["water"]
+    # columns plus airborne spray: round-off only (see test_water)
+    assert d["volume_drift_rel"] < 1e-12 and d["min_depth_m"] >= 0.0
+    assert d["peak_particles"] >= 0
+    stats = {s["name"]: s for s in res.interaction_stats()}
+    assert stats["ball0-water"]["force_N"]["max"] > 0  # logged in every mode
+    frames = res.frames["water"]
+    assert frames["heights"].shape[1:] == scene.systems[0].shape
+    if mode == "hybrid":
+        assert "standin" in stats["ball0-water"]
+
+
+def test_pond_light_balls_float_and_the_dense_one_sinks():
+    m, params = small("pond", **{"basin.cells": "64"})
+    scene = m.build("two-way", duration=2.0, fps=10, params=params)
+    res = scene.simulate()
+    z = {s.name: s.x[2] for s in scene.systems if s.name.startswith("ball")}
+    level = params.basin.depth
+    for k in range(4):  # densities 300-850: afloat, centre within a radius of the surface
+        assert abs(z[f"ball{k}"] - level) < params.balls.radius[k]
+    assert z["ball4"] == pytest.approx(params.balls.radius[4], abs=0.01)  # on the bed
+    assert res.summary()["diagnostics"]["water"]["peak_particles"] > 0  # the splash
+
+
+def test_pond_ball_count_must_match_the_lists():
+    m, params = small("pond", **{"balls.count": "7"})
+    with pytest.raises(ParameterError, match=r"balls.count=7 but balls.radius lists 5 values"):
+        m.build("two-way", params=params)
+
+
+def test_pond_refuses_an_integrator():
+    m, params = small("pond")
+    with pytest.raises(ParameterError, match="--integrator implicit does not apply"):
+        m.build("two-way", integrator="implicit", params=params)
+
+
+def test_puddle_splashes_one_way():
+    m, params = small("puddle", **{"basin.cells": "80"})
+    scene = m.build("one-way", duration=0.6, fps=20, params=params)
+    res = scene.simulate()
+    assert [p.label for p in res.passes] == ["foot", "water"]
+    d = res.summary()["diagnostics"]["water"]
+    assert d["peak_particles"] > 0 and d["volume_drift_rel"] < 1e-12
+    foot = scene.primary
+    np.testing.assert_allclose(res.state_at("foot", 0.4)[0], foot._path(0.4), atol=1e-12)
+
+
+def test_cli_runs_pond_and_writes_the_water_diagnostics(tmp_path, capsys):
+    code = main(["run", "pond", "--duration", "0.3", "--set", "basin.cells=48", "--set",
+                 "balls.count=2", "--out", str(tmp_path), "--quiet", "--no-usd", "--no-obj",
+                 "--no-video", "--no-report"])
+    assert code == 0, capsys.readouterr().err
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert {"volume_drift_rel", "peak_particles", "min_depth_m"} <= set(s["diagnostics"]["water"])
+    assert {i["name"] for i in s["interactions"]} >= {"ball0-water", "ball1-water"}
+
+
+def test_cli_reports_an_unstable_water_step_on_one_line(tmp_path, capsys):
+    code = main(["run", "puddle", "--dt", "0.5", "--out", str(tmp_path), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 2 and "wave-speed limit" in err and len(err.strip().splitlines()) == 1
