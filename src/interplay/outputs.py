@@ -134,7 +134,7 @@ def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
                StepBar("OBJ sequence", options.quiet))
         paths.append(out / "obj")
         files["OBJ sequences (one file per frame)"] = out / "obj"
-    video = None
+    video = st = None
     if options.video:
         from .render.video import render_video
         st = render_video(run, out / "preview.mp4", options.size, options.video_fps,
@@ -148,7 +148,7 @@ def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
         from .report import write_run_report
         shown = {k: v for k, v in tm.items() if k.endswith("_s")}
         written = _timed(tm, "report_s", write_run_report, result, out, summary, files, video,
-                         shown)
+                         shown, st)
         paths += written  # the plots, then report.html
     return paths
 
@@ -162,7 +162,7 @@ def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
     out = ensure_writable(out_dir)
     runs = {m: from_result(r) for m, r in results.items()}
     paths = []
-    video = None
+    video = st = None
     if options.video:
         from .render.video import render_side_by_side
         st = render_side_by_side(runs, out / "compare.mp4", options.size, options.video_fps,
@@ -181,6 +181,7 @@ def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
         from .report_text import main_interaction
         it = main_interaction(next(iter(results.values())))
         pair = (it.primary.name, it.secondary.name) if it is not None else None
-        written = write_compare_report(runs, out, rows, advice, video, reports, files, pair)
+        written = write_compare_report(runs, out, rows, advice, video, reports, files, pair,
+                                       st)
         paths += written
     return paths

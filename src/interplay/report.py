@@ -85,6 +85,14 @@ def _video(src, base, caption) -> str:
             f'preload="auto"></video><p class="sub">{_e(caption)}</p>')
 
 
+def _caption(info) -> str:
+    """Size, rate and the --camera spec that reproduces the view."""
+    if not info:
+        return ""
+    w, h = info["size"]
+    return f'{w}x{h} at {info["fps"]:g} frames/s; camera: --camera "{info["camera"]}"'
+
+
 def _masses(summary) -> dict:
     return {s["name"]: s.get("mass_kg") for s in summary.get("systems", [])}
 
@@ -170,11 +178,13 @@ def _diagnostics(summary) -> str:
 
 
 def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
-                     output_timings: dict | None = None) -> list[Path]:
+                     output_timings: dict | None = None, video_info: dict | None = None
+                     ) -> list[Path]:
     """Write report.html and its plots into out_dir; return their paths.
 
     summary: the dict saved as summary.json (its advice may carry a compare's measurements);
-    files: {description: path} of the run's other outputs; video: the preview MP4 or None.
+    files: {description: path} of the run's other outputs; video: the preview MP4 or None;
+    video_info: what render_video returned (size, fps, camera), for the caption.
     """
     from .render.plots import force_plot
     out = Path(out_dir)
@@ -196,7 +206,7 @@ def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
     rows, classes = table_i_rows(summary["interactions"], _masses(summary))
     sc = result.scene
     sections = [
-        ("video", "Preview", _video(video, out, "time and coupling mode in the corner")),
+        ("video", "Preview", _video(video, out, _caption(video_info))),
         ("interactions", "Interaction forces on the primary", "".join(plots)
          or "<p>No interactions.</p>"),
         ("table-i", "Table I statistics",
@@ -219,12 +229,14 @@ def _slug(name) -> str:
 
 def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=None,
                          mode_reports: dict | None = None, files: dict | None = None,
-                         pair: tuple | None = None) -> list[Path]:
+                         pair: tuple | None = None, video_info: dict | None = None
+                         ) -> list[Path]:
     """Write the compare report (report.html) into out_dir: the modes side by side.
 
     runs: {mode: RunData}; rows: {mode: compare row (report_text.mode_row)}; advice: the
     advisor's verdict with the measurements of all modes; mode_reports: {mode: report path};
-    pair: (primary, secondary) names of the compared interaction, for the paper's Table I row.
+    pair: (primary, secondary) names of the compared interaction, for the paper's Table I row;
+    video_info: what render_side_by_side returned, for the caption.
     """
     from .render.plots import height_plot, primary_height
     out = Path(out_dir)
@@ -268,7 +280,8 @@ def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=No
     warns = "".join(f'<p class="warn">{_e(m)}: {_e(w)}</p>' for m in modes
                     for w in rows[m]["warnings"])
     sections = [
-        ("video", "The modes side by side", _video(video, out, " | ".join(modes))),
+        ("video", "The modes side by side",
+         _video(video, out, " | ".join(modes) + "; " + _caption(video_info))),
         ("height", "Primary height over time", plot_html or "<p>No primary recorded.</p>"),
         ("modes", "Measured figures per mode", table + ref_html + warns),
         ("advice", "Coupling advice (the paper's Figure 17)", _advice(advice)),
