@@ -198,7 +198,9 @@ def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
     y = np.empty((n, 3))
     for i in range(n):
         for r in range(3):
-            y[i, r] = hs * v[i, r] + (cprev * (x[i, r] - xp[i, r]) if bdf2 else 0.0)
+            # fixed points never move (and their xp is never recorded): y = 0 there
+            y[i, r] = 0.0 if fixed[i] else (
+                hs * v[i, r] + (cprev * (x[i, r] - xp[i, r]) if bdf2 else 0.0))
     _spring_blocks(x, si, sj, l0, k, kd, tension_only, hs, C, Kblk)
     # diagonal blocks of A not coming from springs: M - h D_diag - h^2 K_diag
     diag = np.zeros((n, 3, 3))
