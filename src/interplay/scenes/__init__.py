@@ -9,6 +9,7 @@ from ..errors import SceneError
 REGISTRY = {
     "basketball": ("basketball", "a basketball falls through a spring-mass net (two-way, "
                                  "one-way or hybrid)"),
+    "bungee": ("bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)"),
     "flags": ("flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)"),
     "leaves": ("leaves", "a passing bicyclist's wake stirs up leaves that settle again (one-way)"),
     "pond": ("pond", "balls of different densities float, bob and sink in a pond (two-way)"),
