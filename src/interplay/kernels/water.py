@@ -337,13 +337,14 @@ def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp,
 
 @njit(cache=True)
 def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_zlo, lid_zhi, lid_scale,
-            lid_vz, n_lid, kappa, ext, x0, y0, l, g, w, damping, body_damping, h, dt_max, cfl, eta,
-            H, out, rate, spray_on, threshold, fraction, vp, radius, drag, px, pv, count, seed, track):
+            lid_vz, n_lid, kappa, ext, x0, y0, l, g, w, damping, body_damping, h, dt_max, cfl,
+            eta, H, out, rate, spray_on, threshold, fraction, vp, radius, drag, px, pv, count,
+            seed, track):
     """Advance the water h seconds in equal substeps no longer than dt_max or the wave-speed
     limit cfl * l / sqrt(g d_max (1 + kappa if bodies touch it)), rechecked each coupling
     step; the bodies' lids move on at their vertical speeds (a lid held still for the step and
-    jumping at its end would hit the water with pressure spikes of kappa v h). track = [peak particle count, min depth (m)] is updated
-    in place. Returns (particle count, substeps taken)."""
+    jumping at its end would hit the water with pressure spikes of kappa v h). track = [peak
+    particle count, min depth (m)] is updated in place. Returns (particle count, substeps)."""
     dmax = max_depth(V, fluid, area)
     stiff = 1.0 + kappa if n_lid > 0 else 1.0
     lim = cfl * l / math.sqrt(g * dmax * stiff) if dmax > 0.0 else dt_max

@@ -188,8 +188,8 @@ class Water(System):
             self.V, self.Q, self.bed, self.pipe, self.fluid, self.nearest, self.area,
             *self._lids(), self.n_lid, self.kappa, self.ext,
             self.origin[0], self.origin[1], self.spacing, self.g, self.pipe_width,
-            self.params.damping, self.params.body_damping, h, dt_max, self.params.cfl, self._eta, self._H, self._work,
-            self.rate, self.spray_on, s.threshold, s.fraction, self.particle_volume, s.radius,
+            self.params.damping, self.params.body_damping, h, dt_max, self.params.cfl,
+            self._eta, self._H, self._work, self.rate, self.spray_on, s.threshold, s.fraction, self.particle_volume, s.radius,
             self.air_drag, self.px, self.pv, self.count, self._steps & 0xFFFFFFFF, self._track)
         self._steps += 1
 
