@@ -11,6 +11,12 @@ def _convert(owner_key: str, text, typ):
     if not isinstance(text, str):
         return text
     origin = typing.get_origin(typ)
+    args = typing.get_args(typ)
+    if type(None) in args:  # Optional: "none" (or "auto") selects None, else the other type
+        if text.strip().lower() in ("none", "auto"):
+            return None
+        others = [a for a in args if a is not type(None)]
+        return _convert(owner_key, text, others[0])
     try:
         if typ is bool:
             low = text.strip().lower()
