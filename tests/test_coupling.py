@@ -134,3 +134,17 @@ def test_without_refinement_the_blow_up_is_an_error():
     scene = B.build("one-way", duration=0.45, dt=1e-4)
     with pytest.raises(StabilityError, match=r"net: strain .* try a smaller --dt"):
         scene.simulate(refine_unstable=False)
+
+
+def test_advisor_says_one_way_for_an_animated_primary():
+    from interplay.analysis import advise
+
+    class Animated:
+        name, accepts_forces = "foot", False
+
+    class It:
+        primary, standin = Animated(), None
+
+    stats = {"primary": "foot", "acceleration_m_s2": {"min": 0.0, "max": 900.0, "mean": 500.0}}
+    verdict = advise(stats, It())
+    assert verdict["mode"] == "one-way" and "animation" in verdict["reasons"][0]

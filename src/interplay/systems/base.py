@@ -26,6 +26,9 @@ class System:
     kind = "system"
     #: False for systems that ignore forces (static colliders, playback of a track).
     dynamic = True
+    #: False for animation (keyframes, motion capture): it is stepped but nothing can push back
+    #: on it, so only one-way coupling applies to its interactions (SPEC 2.3).
+    accepts_forces = True
 
     def __init__(self, name: str, dt: float):
         if not name or not isinstance(name, str):

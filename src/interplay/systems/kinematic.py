@@ -34,6 +34,7 @@ class KeyframedBody(System):
     are accepted and ignored (``add_wrench``)."""
 
     kind = "kinematic"
+    accepts_forces = False
     integrator = "keyframes (monotone cubic Hermite)"
 
     def __init__(self, name, params: KeyframedBodyParams = KeyframedBodyParams()):
