@@ -31,6 +31,14 @@ def _rgb(color, scale: float = 1.0) -> tuple:
     return tuple(int(round(255 * min(max(c * scale, 0.0), 1.0))) for c in color)
 
 
+def _finite(p) -> np.ndarray:
+    """The present particles (absent ones are NaN rows); one far below if none, since an
+    empty point cloud cannot be sent."""
+    p = np.asarray(p, dtype=np.float32)
+    p = p[np.isfinite(p).all(axis=1)]
+    return p if len(p) else np.array([[0.0, 0.0, -1e3]], dtype=np.float32)
+
+
 class Viewer:
     """A viser server showing one RunData; ``set_frame(i)`` moves everything to frame i."""
 
@@ -73,6 +81,11 @@ class Viewer:
             h = sc.add_mesh_simple(name, shape.verts.astype(np.float32),
                                    shape.tris.astype(np.uint32), color=color)
             self.handles.append(("pose", shape.name, h))
+        elif shape.form == "parts":
+            for k, (v, t) in enumerate(shape.parts):
+                h = sc.add_mesh_simple(f"{name}/seg_{k:02d}", v.astype(np.float32),
+                                       t.astype(np.uint32), color=color)
+                self.handles.append(("part", (shape.name, k), h))
         elif shape.form == "surface":
             h = sc.add_mesh_simple(name, fr["points"][0].astype(np.float32),
                                    shape.triangles.astype(np.uint32), color=color, side="double")
@@ -83,7 +96,7 @@ class Viewer:
                                      thickness=2.0, thickness_units="screen")
             self.handles.append(("segments", shape, h))
         elif shape.form == "particles":
-            h = sc.add_point_cloud(name, fr["points"][0].astype(np.float32), color,
+            h = sc.add_point_cloud(name, _finite(fr["points"][0]), color,
                                    point_size=max(shape.width, 0.005), point_shape="circle")
             self.handles.append(("points", shape.name, h))
         elif shape.form == "static":
@@ -122,12 +135,16 @@ class Viewer:
                 if kind == "pose":
                     pos, q = self.run.pose(key, i)
                     h.position, h.wxyz = tuple(map(float, pos)), tuple(map(float, q))
+                elif kind == "part":
+                    fr = frames[key[0]]
+                    h.position = tuple(map(float, fr["segment_positions"][i, key[1]]))
+                    h.wxyz = tuple(map(float, fr["segment_orientations"][i, key[1]]))
                 elif kind == "vertices":
                     h.vertices = frames[key]["points"][i].astype(np.float32)
                 elif kind == "segments":
                     h.points = self._segments(key, i)
                 elif kind == "points":
-                    h.points = frames[key]["points"][i].astype(np.float32)
+                    h.points = _finite(frames[key]["points"][i])
             self.clock.value = round(float(self.times[i]), 4)
 
     def play(self, stop: threading.Event | None = None):

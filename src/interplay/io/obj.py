@@ -2,8 +2,8 @@
 
 Layout under the target directory (default ``obj/``):
   <system>/<system>_0000.obj ...   deforming surfaces (v, vn, f), cord networks (v, l),
-                                   particles (v only) and rigid bodies (their mesh posed in
-                                   the world: OBJ has no transforms)
+                                   particles (v only), rigid bodies and figures (their
+                                   meshes posed in the world: OBJ has no transforms)
   <static>.obj                     static systems, once
 Coordinates are metres, +z up, as everywhere in Interplay (many tools assume +y up: rotate
 on import). The whole directory is written under a temporary name and renamed when complete,
@@ -59,12 +59,21 @@ def _frame_geometry(shape, run, i):
     if shape.form == "body":
         pos, q = run.pose(shape.name, i)
         return shape.verts @ quat_matrix(q).T + pos, shape.tris, None
+    if shape.form == "parts":
+        fr = run.frames[shape.name]
+        pos, quat = fr["segment_positions"][i], fr["segment_orientations"][i]
+        verts, tris, base = [], [], 0
+        for k, (v, t) in enumerate(shape.parts):
+            verts.append(v @ quat_matrix(quat[k]).T + pos[k])
+            tris.append(t + base)
+            base += len(v)
+        return np.concatenate(verts), np.concatenate(tris), None
     pts = run.points(shape.name, i)
     if shape.form == "surface":
         return pts, shape.triangles, None
     if shape.form == "cords":
         return pts, None, shape.segments
-    return pts, None, None
+    return pts[np.isfinite(pts).all(axis=1)], None, None  # absent particles are NaN rows
 
 
 def write_obj_sequence(run, out_dir, progress=None) -> list[Path]:

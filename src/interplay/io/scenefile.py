@@ -6,9 +6,12 @@ preview renderer and the web viewer read one structure and need no scene-specifi
 
 Each system becomes a ``Shape`` of one *form*:
   body       a rigid body: a body-frame mesh moved by per-frame position + orientation
-  surface    a deforming mesh: per-frame points and fixed triangles
+  parts      an articulated figure: one body-frame mesh per segment, moved by per-frame
+             segment_positions (k,3) + segment_orientations (k,4)
+  surface    a deforming mesh: per-frame points and fixed triangles (a height field's points
+             are made from its grid and per-frame heights)
   cords      a network without faces: per-frame points and fixed (s,2) segments
-  particles  per-frame points only
+  particles  per-frame points only (NaN rows are absent particles: spray)
   static     a world-space mesh that never moves (the floor)
 """
 from __future__ import annotations
@@ -23,6 +26,10 @@ from ..errors import InterplayError
 from .atomic import atomic_path
 
 SCENE_FILE = "scene.json"
+QUATERNION_KEYS = ("orientation", "segment_orientations")  # (w, x, y, z), last axis
+# what outputs read back from tracks.npz
+FRAME_KEYS = ("t", "points", "position", "orientation", "segment_positions",
+              "segment_orientations", "heights", "particles")
 FORMAT_VERSION = 1
 
 # linear RGB in 0..1; a system may carry its own ``color`` attribute instead
@@ -38,7 +45,9 @@ class Shape:
 
     verts/tris: body-frame mesh (body) or world mesh (static); triangles: faces over the
     per-frame points (surface); segments: (s,2) point pairs (cords); width: cord or particle
-    diameter (m); anchors: (a,3) fixed world points a network hangs from (drawn as hooks).
+    diameter (m); anchors: (a,3) fixed world points a network hangs from (drawn as hooks);
+    parts: [(verts, tris)] per segment of a figure; grid_xy: (n,2) column centres of a height
+    field; source: (system, frame key) a derived shape's points come from (water spray).
     """
     name: str
     form: str
@@ -49,6 +58,9 @@ class Shape:
     segments: np.ndarray | None = None
     width: float = 0.0
     anchors: np.ndarray | None = None
+    parts: list | None = None
+    grid_xy: np.ndarray | None = None
+    source: tuple | None = None
 
     @property
     def animated(self) -> bool:
@@ -57,20 +69,30 @@ class Shape:
     def to_json(self) -> dict:
         out = {"name": self.name, "form": self.form, "color": list(self.color),
                "width": self.width}
-        for key in ("verts", "tris", "triangles", "segments", "anchors"):
+        for key in ("verts", "tris", "triangles", "segments", "anchors", "grid_xy"):
             val = getattr(self, key)
             if val is not None:
                 out[key] = np.asarray(val).tolist()
+        if self.parts is not None:
+            out["parts"] = [[np.asarray(v).tolist(), np.asarray(t).tolist()]
+                            for v, t in self.parts]
+        if self.source is not None:
+            out["source"] = list(self.source)
         return out
 
     @staticmethod
     def from_json(d: dict) -> "Shape":
         arrays = {}
         for key, dtype in (("verts", float), ("tris", np.int64), ("triangles", np.int64),
-                           ("segments", np.int64), ("anchors", float)):
+                           ("segments", np.int64), ("anchors", float), ("grid_xy", float)):
             if key in d:
-                cols = 2 if key == "segments" else 3
+                cols = 2 if key in ("segments", "grid_xy") else 3
                 arrays[key] = np.asarray(d[key], dtype=dtype).reshape(-1, cols)
+        if "parts" in d:
+            arrays["parts"] = [(np.asarray(v, float).reshape(-1, 3),
+                                np.asarray(t, np.int64).reshape(-1, 3)) for v, t in d["parts"]]
+        if "source" in d:
+            arrays["source"] = tuple(d["source"])
         return Shape(d["name"], d["form"], tuple(d["color"]), width=float(d.get("width", 0.0)),
                      **arrays)
 
@@ -127,10 +149,15 @@ class RunData:
             if key == "t":
                 continue
             q0, q1 = arr[j], arr[j + 1]
-            if key == "orientation" and np.dot(q0, q1) < 0:
-                q1 = -q1  # the shorter way round
-            v = (1 - a) * q0 + a * q1
-            out[key] = v / np.linalg.norm(v) if key == "orientation" else v
+            if np.isnan(q0).any() or np.isnan(q1).any():
+                out[key] = q0 if a < 0.5 else q1  # particles come and go: no blending
+            elif key in QUATERNION_KEYS:
+                # the shorter way round, row by row, then back to unit length
+                q1 = np.where((q0 * q1).sum(-1, keepdims=True) < 0, -q1, q1)
+                v = (1 - a) * q0 + a * q1
+                out[key] = v / np.linalg.norm(v, axis=-1, keepdims=True)
+            else:
+                out[key] = (1 - a) * q0 + a * q1
         return out
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -143,9 +170,13 @@ class RunData:
                 r = float(np.max(np.linalg.norm(s.verts, axis=1))) if s.verts is not None else 0
                 p = fr["position"]
                 pts += [p.min(0) - r, p.max(0) + r]
-            elif "points" in fr and len(fr["points"]):
+            elif s.form == "parts" and len(fr.get("segment_positions", ())):
+                r = max(float(np.max(np.linalg.norm(v, axis=1))) for v, _ in s.parts)
+                p = fr["segment_positions"]
+                pts += [p.min((0, 1)) - r, p.max((0, 1)) + r]
+            elif "points" in fr and np.isfinite(fr["points"]).any():
                 p = fr["points"]
-                pts += [p.min((0, 1)), p.max((0, 1))]
+                pts += [np.nanmin(p, (0, 1)), np.nanmax(p, (0, 1))]
             if s.anchors is not None and len(s.anchors):
                 pts += [s.anchors.min(0), s.anchors.max(0)]
         if not pts:
@@ -177,13 +208,41 @@ def _cord_width(system, points, segments) -> float:
     return float(np.clip(0.08 * np.median(lengths), 0.002, 0.02))
 
 
-def shape_of(system, frames: dict, kind_counts: dict | None = None) -> Shape | None:
-    """The Shape of one system, or None if it has nothing to draw."""
+def shapes_of(system, frames: dict, kind_counts: dict | None = None) -> list[Shape]:
+    """The Shapes of one system (none if it has nothing to draw; a water system gives its
+    surface and its spray)."""
     kind_counts = {} if kind_counts is None else kind_counts
     color = _color(system, kind_counts)
     name = system.name
-    if "position" in frames and "orientation" in frames and hasattr(system, "surface"):
-        v, t = system.surface(3) if _takes_arg(system.surface) else system.surface()
+    if "segment_positions" in frames and hasattr(system, "segment_meshes"):
+        parts = [(np.asarray(v, float), np.asarray(t, np.int64))
+                 for v, t in system.segment_meshes()]
+        return [Shape(name, "parts", color, parts=parts)]
+    if "heights" in frames and hasattr(system, "surface"):
+        verts, tris = system.surface()
+        out = [Shape(name, "surface", color, triangles=np.asarray(tris, np.int64),
+                     grid_xy=np.asarray(verts, float)[:, :2])]
+        if "particles" in frames:
+            r = frames.get("particle_radius")
+            width = 2 * float(np.nanmax(r)) if r is not None and np.isfinite(r).any() else 0.008
+            out.append(Shape(f"{name}-spray", "particles", color, width=width,
+                             source=(name, "particles")))
+        return out
+    shape = _single_shape(system, frames, color)
+    return [shape] if shape is not None else []
+
+
+def _single_shape(system, frames, color) -> Shape | None:
+    name = system.name
+    if "position" in frames and "orientation" in frames:
+        if hasattr(system, "surface"):
+            v, t = system.surface(3) if _takes_arg(system.surface) else system.surface()
+        elif getattr(system, "semi_axes", None) is not None:  # an ellipsoid (keyframed foot)
+            from ..geometry.sphere import icosphere
+            v, t = icosphere(3)
+            v = v * np.asarray(system.semi_axes, float)
+        else:
+            return None
         return Shape(name, "body", color, verts=np.asarray(v, float), tris=np.asarray(t))
     if "points" in frames:
         pts = np.asarray(frames["points"][0]) if len(frames["points"]) else np.zeros((0, 3))
@@ -218,11 +277,26 @@ def from_result(result) -> RunData:
     counts: dict = {}
     shapes = []
     for s in sc.systems:
-        sh = shape_of(s, result.frames.get(s.name, {}), counts)
-        if sh is not None:
-            shapes.append(sh)
+        shapes += shapes_of(s, result.frames.get(s.name, {}), counts)
+    frames = _derive(dict(result.frames), shapes)  # the Result's own dict stays untouched
     return RunData(sc.name, sc.coupling, float(sc.fps), float(sc.duration), shapes,
-                   result.frames, sc.primary.name if sc.primary is not None else None)
+                   frames, sc.primary.name if sc.primary is not None else None)
+
+
+def _derive(frames: dict, shapes) -> dict:
+    """Add the per-frame points of derived shapes: a height field's grid + heights, spray
+    from its system's particle array."""
+    for s in shapes:
+        if s.grid_xy is not None and "heights" in frames.get(s.name, {}):
+            fr = dict(frames[s.name])
+            h = np.asarray(fr["heights"]).reshape(len(fr["heights"]), -1)
+            xy = np.broadcast_to(s.grid_xy, (len(h), *s.grid_xy.shape))
+            fr["points"] = np.concatenate([xy, h[..., None]], axis=-1)
+            frames[s.name] = fr
+        elif s.source is not None and s.source[0] in frames:
+            src = frames[s.source[0]]
+            frames[s.name] = {"t": src["t"], "points": src[s.source[1]]}
+    return frames
 
 
 def write_scene_file(run: RunData, out_dir) -> Path:
@@ -251,8 +325,9 @@ def load_run(run_dir) -> RunData:
         with np.load(tracks_path) as npz:
             for key in npz.files:
                 name, _, field_ = key.rpartition("/")
-                if field_ in ("t", "points", "position", "orientation"):
+                if field_ in FRAME_KEYS:
                     frames.setdefault(name, {})[field_] = npz[key]
+        frames = _derive(frames, shapes)
     except (ValueError, KeyError, OSError) as e:
         raise InterplayError(f"{d}: cannot read the saved run ({e}); run it again") from None
     summary = None

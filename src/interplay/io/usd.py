@@ -3,10 +3,11 @@
 Stage layout (``/World`` is the default prim):
   /World/<body>        Xform, time-sampled xformOp:translate (double3) + xformOp:orient (quatd)
   /World/<body>/mesh   its static body-frame Mesh (smooth vertex normals)
+  /World/<figure>/seg_NN  one such Xform + mesh per segment of an articulated figure
   /World/<surface>     Mesh with time-sampled points, normals and extent
   /World/<cords>       BasisCurves (linear, one 2-point curve per cord) with time-sampled
                        points and extent and a constant width: cords have no faces to shade
-  /World/<particles>   Points with time-sampled positions
+  /World/<particles>   Points with time-sampled positions (their number may change per frame)
   /World/<static>      Mesh (the floor)
 Every gprim carries a constant ``primvars:displayColor``. Time code i is output frame i:
 timeCodesPerSecond = framesPerSecond = the run's fps.
@@ -74,7 +75,7 @@ def build_stage(run):
         used.add(name)
         path = f"/World/{name}"
         fr = run.frames.get(shape.name, {})
-        writer = {"body": _body, "surface": _surface, "cords": _cords,
+        writer = {"body": _body, "parts": _parts, "surface": _surface, "cords": _cords,
                   "particles": _particles, "static": _static}[shape.form]
         writer(stage, path, shape, fr, nf)
     return stage
@@ -104,22 +105,34 @@ def _extent(pts, pad=0.0):
     return Vt.Vec3fArray.FromNumpy(np.stack([lo, hi]).astype(np.float32))
 
 
-def _body(stage, path, shape, fr, nf):
+def _posed(stage, path, shape, verts, tris, pos, quat):
+    """An Xform with time-sampled translate + orient over a static mesh."""
     from pxr import Gf, UsdGeom
     xf = UsdGeom.Xform.Define(stage, path)
     tr = xf.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble)
     orient = xf.AddOrientOp(UsdGeom.XformOp.PrecisionDouble)
-    pos, quat = fr["position"], fr["orientation"]
     for i in range(len(pos)):
         tr.Set(Gf.Vec3d(*map(float, pos[i])), i)
         w, x, y, z = map(float, quat[i])
         orient.Set(Gf.Quatd(w, x, y, z), i)
     mesh = UsdGeom.Mesh.Define(stage, f"{path}/mesh")
-    _mesh_topology(mesh, shape.tris)
-    mesh.CreatePointsAttr(_vec3f(shape.verts))
-    mesh.CreateNormalsAttr(_vec3f(vertex_normals(shape.verts, shape.tris)))
-    mesh.CreateExtentAttr(_extent(shape.verts))
+    _mesh_topology(mesh, tris)
+    mesh.CreatePointsAttr(_vec3f(verts))
+    mesh.CreateNormalsAttr(_vec3f(vertex_normals(verts, tris)))
+    mesh.CreateExtentAttr(_extent(verts))
     _color(mesh, shape)
+
+
+def _body(stage, path, shape, fr, nf):
+    _posed(stage, path, shape, shape.verts, shape.tris, fr["position"], fr["orientation"])
+
+
+def _parts(stage, path, shape, fr, nf):
+    from pxr import UsdGeom
+    UsdGeom.Xform.Define(stage, path)
+    pos, quat = fr["segment_positions"], fr["segment_orientations"]
+    for k, (v, t) in enumerate(shape.parts):
+        _posed(stage, f"{path}/seg_{k:02d}", shape, v, t, pos[:, k], quat[:, k])
 
 
 def _surface(stage, path, shape, fr, nf):
@@ -156,6 +169,7 @@ def _particles(stage, path, shape, fr, nf):
     pts.SetWidthsInterpolation(UsdGeom.Tokens.constant)
     pa, ea = pts.CreatePointsAttr(), pts.CreateExtentAttr()
     for i, p in enumerate(fr["points"]):
+        p = p[np.isfinite(p).all(axis=1)]  # absent particles are NaN rows
         pa.Set(_vec3f(p), i)
         ea.Set(_extent(p, (shape.width or 0.01) / 2) if len(p) else _extent(np.zeros((1, 3))), i)
     _color(pts, shape)

@@ -64,6 +64,18 @@ def quat_matrix4(pos, q) -> np.ndarray:
     return m
 
 
+def ground_shape(lo, hi):
+    """A floor quad (a static Shape) just under the box [lo, hi], 20 m or 10 box sizes wide."""
+    from ..io.scenefile import Shape
+    c = (np.asarray(lo) + np.asarray(hi)) / 2
+    s = max(10.0, 5 * float(np.max(np.asarray(hi) - np.asarray(lo))))
+    z = float(lo[2]) - 1e-3
+    v = np.array([[c[0] - s, c[1] - s, z], [c[0] + s, c[1] - s, z], [c[0] + s, c[1] + s, z],
+                  [c[0] - s, c[1] + s, z]])
+    return Shape("ground", "static", (0.55, 0.55, 0.57), verts=v, tris=np.array([[0, 1, 2],
+                                                                               [0, 2, 3]]))
+
+
 def _unit_cylinder(sides=6):
     a = 2 * np.pi * np.arange(sides) / sides
     ring = np.stack([np.cos(a), np.sin(a), np.zeros(sides)], axis=1)
@@ -111,6 +123,10 @@ class Renderer:
         self.depth = {k: ctx.program(vertex_shader=vs, fragment_shader=shaders.DEPTH_FS)
                       for k, vs in (("mesh", shaders.MESH_VS), ("tube", shaders.TUBE_VS),
                                     ("ball", shaders.BALL_VS))}
+        # a scene without a floor still gets one under its lowest point, for scale and shadows
+        self.shapes = list(run.shapes)
+        if not any(s.form == "static" for s in self.shapes):
+            self.shapes.append(ground_shape(lo, hi))
         self._setup_matrices(run, lo, hi)
         self._objects = []
         self._resources = [self.fbo, self.resolve, self.shadow_tex, self.shadow_fbo,
@@ -118,7 +134,7 @@ class Renderer:
         # cords and knots are a few pixels wide: six-sided tubes and icosahedra look round
         # there and keep the vertex work small (llvmpipe); hooks and particles get more
         cyl, self._knot_sphere, sph = _unit_cylinder(), _unit_sphere(0), _unit_sphere(1)
-        for shape in run.shapes:
+        for shape in self.shapes:
             self._add(shape, run, cyl, sph)
 
     # --- setup -----------------------------------------------------------------------------
@@ -130,7 +146,7 @@ class Renderer:
         near = max(0.02, (dist - radius) * 0.2)
         far = dist + radius + 60.0
         self.vp = cam.projection(self.w / self.h, near, far) @ cam.view()
-        static = [s.verts[:, 2].min() for s in run.shapes if s.form == "static"]
+        static = [s.verts[:, 2].min() for s in self.shapes if s.form == "static"]
         self.ground_z = float(min(static)) if static else float(lo[2])
         self.uniforms = {"u_eye": tuple(map(float, cam.eye)), "u_light_dir": tuple(SUN),
                          "u_sky": tuple(SKY),
@@ -190,14 +206,22 @@ class Renderer:
                                   "color": color, "checker": shape.form == "static",
                                   "casts": shape.form == "body",
                                   "extent": float(np.linalg.norm(shape.verts, axis=1).max())})
+        elif shape.form == "parts":
+            for k, (v, t) in enumerate(shape.parts):
+                vbo, ibo = self._static_geometry(v, fast_normals(v, t), t)
+                vao, dvao = self._vaos("mesh", vbo, ibo)
+                self._objects.append({"shape": shape, "kind": "mesh", "part": k, "vao": vao,
+                                      "dvao": dvao, "color": color, "casts": True,
+                                      "extent": float(np.linalg.norm(v, axis=1).max())})
         elif shape.form == "surface":
             n = len(run.frames[shape.name]["points"][0])
             vbo = self._buffer(np.zeros((n, 6)), dynamic=True)
             ibo = self.ctx.buffer(np.ascontiguousarray(shape.triangles, np.int32).tobytes())
             self._resources.append(ibo)
             vao, dvao = self._vaos("mesh", vbo, ibo)
+            # a water surface (a height field) lets the light through to its bed
             self._objects.append({"shape": shape, "kind": "surface", "vao": vao, "dvao": dvao,
-                                  "vbo": vbo, "color": color, "casts": True})
+                                  "vbo": vbo, "color": color, "casts": shape.grid_xy is None})
         elif shape.form == "cords":
             r = shape.width / 2
             vbo, ibo = self._static_geometry(*cyl)
@@ -240,9 +264,12 @@ class Renderer:
                 states[shape.name] = run.sample(shape.name, t)
             st = states[shape.name]
             if ob["kind"] == "mesh":
-                ob["model"] = quat_matrix4(st["position"], st["orientation"])
+                k = ob.get("part")
+                pos = st["position"] if k is None else st["segment_positions"][k]
+                ob["model"] = quat_matrix4(pos, st["orientation"] if k is None
+                                           else st["segment_orientations"][k])
                 r = ob["extent"]
-                boxes += [st["position"] - r, st["position"] + r]
+                boxes += [pos - r, pos + r]
             elif ob["kind"] == "surface":
                 p = st["points"]
                 ob["vbo"].write(np.concatenate([p.astype(np.float32),
@@ -252,9 +279,14 @@ class Renderer:
                 seg = shape.segments
                 ob["inst"].write(np.concatenate([p[seg[:, 0]], p[seg[:, 1]]], 1).tobytes())
             elif ob["kind"] == "knots":
-                ob["inst"].write(st["points"].astype(np.float32).tobytes())
-            if "points" in st and len(st["points"]):
-                boxes += [st["points"].min(0), st["points"].max(0)]
+                p = st["points"]
+                p = p[np.isfinite(p).all(axis=1)]  # absent particles (spray) are NaN rows
+                ob["count"] = len(p)
+                if len(p):
+                    ob["inst"].write(p.astype(np.float32).tobytes())
+            p = st.get("points")
+            if p is not None and np.isfinite(p).any():
+                boxes += [np.nanmin(p, 0), np.nanmax(p, 0)]
         for ob in self._objects:
             if ob["kind"] == "hooks":
                 boxes += [ob["anchors"].min(0), ob["anchors"].max(0)]
@@ -281,7 +313,7 @@ class Renderer:
             if ob["kind"] in ("mesh", "surface"):
                 _set(prog, "u_model", ob.get("model", np.eye(4)))
                 vao.render()
-            else:
+            elif ob["count"]:
                 _set(prog, "u_radius", ob["radius"])
                 vao.render(instances=ob["count"])
 
