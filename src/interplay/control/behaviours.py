@@ -30,13 +30,14 @@ def crouch(name="crouch", next=None, after=0.6, depth=1.0, lean=0.3) -> State:
                  support=True, balance=STANCE_BALANCE, transitions=trans, blend=0.5 * after)
 
 
-def leap(name="leap", next=None, after=0.35, power=1.0, arm_swing=2.6) -> State:
-    """Extend hips, knees and ankles together (a timed push, velocity targets scaled by power)
-    while the arms swing forward and up to ``arm_swing`` (rad); hands over when both feet
-    leave the ground, or after ``after`` s."""
+def leap(name="leap", next=None, after=0.35, power=1.0, arm_swing=2.6, hip=-0.1) -> State:
+    """Extend hips (to ``hip`` rad of flexion: below 0 a vertical jump, above 0 a forward
+    dive), knees and ankles together (a timed push, velocity targets scaled by power) while the
+    arms swing forward and up to ``arm_swing`` (rad); hands over when both feet leave the
+    ground, or after ``after`` s."""
     trans = ((Transition("no_foot_contact", next), Transition("time", next, after))
              if next else ())
-    return State(name, pose=(("hip_flex", -0.1), ("knee", 0.0), ("ankle", -0.6),
+    return State(name, pose=(("hip_flex", hip), ("knee", 0.0), ("ankle", -0.6),
                              ("waist_flex", 0.0), ("shoulder_flex", arm_swing), ("elbow", 0.0),
                              ("toe", 0.3)),
                  velocity=(("hip_flex", -8.0 * power), ("knee", -12.0 * power),

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..control.gravity import GravityCompensation
 from ..control.fsm import Controller, StateMachine
 from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
@@ -33,7 +34,9 @@ class FigureParams:
     """body: mass and height; environment: ground and platforms; position (m): the ground point
     below the pelvis at rest; yaw (rad): heading about +z (0 faces +x); dt (s): MuJoCo's step;
     control_dt (s): the controller's period; omega (rad/s) and zeta (-): default servo natural
-    frequency and damping ratio."""
+    frequency and damping ratio; support_omega (rad/s): the stance legs' frequency while they
+    carry the body (about the whole body's inertia, so soft, with tau_g holding the weight); gravity_compensation: add the feed-forward torques that hold the
+    desired pose against gravity (control/gravity.py) to the servo law."""
     body: BodyParams = BodyParams()
     environment: EnvironmentParams = EnvironmentParams()
     position: tuple = (0.0, 0.0, 0.0)  # m
@@ -42,6 +45,8 @@ class FigureParams:
     control_dt: float = 5e-3  # s
     omega: float = 20.0  # rad/s
     zeta: float = 1.0
+    support_omega: float = 8.0  # rad/s
+    gravity_compensation: bool = True
 
 
 def _qmul(a, b):
@@ -119,10 +124,17 @@ class Figure(System):
         self._next_control = 0.0
         self.balance_offset = 0.0
         self._blend = None
+        feet = [SEGMENTS.index(f) for f in ("l_foot", "r_foot")]
+        self.foot_contact_geoms = [self.seg_geom[[k, k + 1]] for k in feet]  # sole and toes
+        self.gravity = GravityCompensation(m, self.qadr, self.vadr, self.seg_body[feet],
+                                           self.seg_geom[feet], self.free)
+        self._c0, self._dc, self._ff = np.zeros(len(jid)), np.zeros(len(jid)), np.zeros(len(jid))
+        self._tick = 0.0
         if self.fsm is not None:
             self._enter(self.fsm.start)
         self.apply_gains()
-        self._set_ctrl()
+        self._ff[:] = self._feedforward(self.targets)
+        self._plan(0.0)
         nq = m.nq
         self._gx, self._gv = np.zeros(nq), np.zeros(nq)
         self._probe = geom_probe_points(m, self.seg_geom)
@@ -135,20 +147,43 @@ class Figure(System):
         self.model.actuator_biasprm[:, 1] = -self.kp
         self.model.actuator_biasprm[:, 2] = -self.kd
 
-    def _set_ctrl(self, t=None):
+    def _reference(self, t, balance=True):
+        """Desired angles (rad) and rates (rad/s) at time t (s): the state's targets, reached
+        along a smoothstep 3u^2 - 2u^3 from where the previous state left them, plus the
+        balance offset on the ankles."""
         target, vtarget = self.targets.copy(), self.vtargets.copy()
-        if t is not None and self._blend is not None:
+        if self._blend is not None:
             start, end, t0, T = self._blend
-            u = (t - t0) / T
-            if u >= 1.0:
-                self._blend = None
-            else:  # smoothstep 3u^2 - 2u^3 and its rate
-                u = max(u, 0.0)
-                target = start + (end - start) * (3 * u * u - 2 * u ** 3)
-                vtarget = vtarget + (end - start) * (6 * u - 6 * u * u) / T
-        if self.balance_offset:
+            u = min(max((t - t0) / T, 0.0), 1.0)
+            target = start + (end - start) * (3 * u * u - 2 * u ** 3)
+            vtarget += (end - start) * (6 * u - 6 * u * u) / T
+        if balance and self.balance_offset:
             target[self.ankles] += self.balance_offset
-        self.data.ctrl[:] = self.kp * target + self.kd * vtarget
+        return target, vtarget
+
+    def _feedforward(self, target) -> np.ndarray:
+        """Gravity compensation (N m) for the desired angles (control/gravity.py): the weight
+        on the feet while the state says they carry the body and one touches the ground."""
+        if not self.params.gravity_compensation or (self.free and not self.support):
+            return np.zeros(len(target))
+        feet = np.zeros(0, np.int64)
+        if self.free:
+            geoms = self.data.contact.geom[:self.data.ncon]
+            feet = np.flatnonzero([np.isin(g, geoms).any() for g in self.foot_contact_geoms])
+        return self.gravity.torques(self.data.qpos, target, feet)
+
+    def _plan(self, t):
+        """The servo reference over the control period from t (s): the actuators' ctrl
+        (kp theta_d + kd thetadot_d + tau_g) at both ends; every MuJoCo step in between
+        interpolates it linearly (``_run``), so targets never jump by a whole period's change."""
+        th0, w0 = self._reference(t)
+        th1, w1 = self._reference(t + self.control_dt)
+        ff1 = self._feedforward(th1)
+        self._c0[:] = self.kp * th0 + self.kd * w0 + self._ff
+        self._dc[:] = self.kp * th1 + self.kd * w1 + ff1 - self._c0
+        self._ff[:] = ff1
+        self._tick = t
+        self.data.ctrl[:] = self._c0
 
     def angles(self) -> np.ndarray:
         """Current joint angles (rad), in ``joints`` order."""
@@ -160,13 +195,19 @@ class Figure(System):
             self.targets[:] = targets
         if velocities is not None:
             self.vtargets[:] = velocities
-        self._set_ctrl()
+        self._blend = None
+        self._ff[:] = self._feedforward(self.targets)
+        self._plan(self.time)
 
     def _enter(self, index, t=0.0):
-        start = self.targets.copy()
+        start = self._reference(t, balance=False)[0]
         self.fsm.enter(index, t, self.targets, self.vtargets, self.angles(), self.omega,
                        self.zeta, self.params.omega, self.params.zeta)
         self.support = self.fsm.state.support
+        if self.support:  # stance legs: soft gains, tau_g carries the weight
+            soft = self.leg.copy()
+            soft[self.fsm.state.gain_idx] = False
+            self.omega[soft] = self.params.support_omega
         T = self.fsm.state.blend
         self._blend = (start, self.targets.copy(), t, T) if T > 0 and t > 0 else None
         self.apply_gains()
@@ -188,7 +229,9 @@ class Figure(System):
             if nxt is not None:
                 self._enter(nxt, t)
             self.balance_offset = self._balance(s) if self.fsm.state.balance else 0.0
-            self._set_ctrl(t)
+        if self._blend is not None and t >= self._blend[2] + self._blend[3]:
+            self._blend = None
+        self._plan(t)
         self._next_control += self.control_dt
 
     def _balance(self, s) -> float:
@@ -230,18 +273,17 @@ class Figure(System):
             w[3:] += torque
 
     def _run(self, n: int, sub: float):
-        m, d = self.model, self.data
+        m, d, mj = self.model, self.data, self._mj
         if m.opt.timestep != sub:
             m.opt.timestep = sub
-        done, t = 0, self.time
-        while done < n:
+        ctrl, c0, dc, rate = d.ctrl, self._c0, self._dc, 1.0 / self.control_dt
+        for k in range(n):
+            t = self.time + k * sub
             if t >= self._next_control - 1e-9 * sub:
                 self._control(t)
-            k = min(n - done, max(1, math.ceil((self._next_control - t) / sub - 1e-9)))
-            self._mj.mj_step(m, d, nstep=k)
-            done += k
-            t = self.time + done * sub
-        return t
+            np.multiply(dc, (t - self._tick) * rate, out=ctrl)
+            ctrl += c0
+            mj.mj_step(m, d)
 
     def step(self, h):
         self._run(1, h)
@@ -332,7 +374,8 @@ class Figure(System):
                                   self.fsm.entered if self.fsm else 0.0]),
                     support=np.array(self.support), balance=np.array(self.balance_offset),
                     blend=np.zeros(0) if self._blend is None else np.concatenate(
-                        [self._blend[0], self._blend[1], self._blend[2:]]))
+                        [self._blend[0], self._blend[1], self._blend[2:]]),
+                    servo=np.concatenate([self._c0, self._dc, self._ff, [self._tick]]))
         return snap
 
     def restore(self, snap):
@@ -350,7 +393,9 @@ class Figure(System):
         b, n = snap["blend"], len(self.targets)
         self._blend = None if len(b) == 0 else (b[:n].copy(), b[n:2 * n].copy(), b[-2], b[-1])
         self.apply_gains()
-        self._set_ctrl()
+        n3 = 3 * n
+        self._c0[:], self._dc[:], self._ff[:] = (snap["servo"][:n3].reshape(3, n))
+        self._tick = float(snap["servo"][n3])
         self._mj.mj_forward(self.model, d)
 
     def frame(self):
