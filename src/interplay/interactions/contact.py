@@ -114,13 +114,22 @@ class SpherePlaneContact(Interaction):
         super().__init__(name, ball, plane, mode)
         self.p = params.validated(name)
         self._wrench = np.zeros(6)
+        self._dfdx = np.zeros((3, 3))
+        self._dfdx[2, 2] = -self.p.stiffness
+        self._dfdv = np.zeros((3, 3))
+        self._dfdv[2, 2] = -self.p.damping
+        self._h = 0.0
+
+    def prepare(self, h):
+        self._h = h  # the friction cap: the force is held over the whole coupling step
 
     def exchange(self, to_primary, to_secondary):
         ball, p = self.primary, self.p
-        on = sphere_plane(ball.x, ball.v, ball.w, ball.radius, ball.mass, ball.gravity[2],
-                          self.secondary.height, p.stiffness, p.damping, p.friction, p.eps,
-                          self._wrench)
+        on = sphere_plane(ball.x, ball.v, ball.w, ball.radius, ball.mass, ball.inertia_body[0],
+                          ball.gravity[2], self.secondary.height, p.stiffness, p.damping,
+                          p.friction, p.eps, self._h, self._wrench)
         if on and to_primary:
-            ball.force += self._wrench[:3]
-            ball.torque += self._wrench[3:]
+            # the normal penalty's Jacobians let the ball integrate the bounce implicitly
+            ball.add_wrench(self._wrench[:3], self._wrench[3:], dfdx=self._dfdx,
+                            dfdv=self._dfdv)
         return self._wrench[:3].copy(), self._wrench[3:].copy(), on

@@ -146,31 +146,42 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
 
 
 @njit(cache=True)
-def sphere_plane(c, vc, w, radius, mass, acc_n, height, cs, cd, mu, eps, wrench):
+def sphere_plane(c, vc, w, radius, mass, inertia, acc_n, height, cs, cd, mu, eps, dt, wrench):
     """A sphere on the plane z = height (normal +z). acc_n: the sphere's free acceleration
-    along +z (m/s^2). Writes force (0:3) and torque (3:6) on the sphere; returns True on contact."""
+    along +z (m/s^2); inertia: its moment of inertia (kg m^2). Writes force (0:3) and torque
+    (3:6) on the sphere; returns True on contact. Friction is capped at the force that stops
+    the contact point's slip within dt (through both the sphere's mass and its inertia), so a
+    rolling ball does not chatter; dt <= 0 disables the cap."""
     for q in range(6):
         wrench[q] = 0.0
     pen = radius - (c[2] - height)
     if pen <= 0.0:
         return False
-    n = np.array([0.0, 0.0, 1.0])
-    r = -radius * n
-    vp = vc + np.cross(w, r)
-    fn = cs * pen - cd * vp[2]
+    # contact point r = (0, 0, -radius); its velocity v + w x r
+    vx = vc[0] - w[1] * radius
+    vy = vc[1] + w[0] * radius
+    vz = vc[2]
+    fn = cs * pen - cd * vz
     if acc_n < 0.0:
         fn += -mass * acc_n
     if fn <= 0.0:
         return False
-    vt = vp - vp[2] * n
-    vtn = np.sqrt(vt[0] * vt[0] + vt[1] * vt[1])
-    F = fn * n
+    fx = 0.0
+    fy = 0.0
+    vtn = np.sqrt(vx * vx + vy * vy)
     if vtn > 0.0:
-        F = F - (mu * fn * min(1.0, vtn / eps) / vtn) * vt
-    tau = np.cross(r, F)
-    for q in range(3):
-        wrench[q] = F[q]
-        wrench[3 + q] = tau[q]
+        fmag = mu * fn * min(1.0, vtn / eps)
+        if dt > 0.0:
+            fmag = min(fmag, vtn / ((1.0 / mass + radius * radius / inertia) * dt))
+        fx = -fmag * vx / vtn
+        fy = -fmag * vy / vtn
+    wrench[0] = fx
+    wrench[1] = fy
+    wrench[2] = fn
+    # torque r x F with r = (0, 0, -radius)
+    wrench[3] = radius * fy
+    wrench[4] = -radius * fx
+    wrench[5] = 0.0
     return True
 
 

@@ -130,7 +130,7 @@ def _apply_A(p, diag, si, sj, C, fixed, out):
 
 
 @njit(cache=True)
-def _inv3(A, out):
+def inv3(A, out):
     """Inverse of a 3x3 matrix by cofactors (LAPACK calls cost microseconds each here)."""
     a, b, c = A[0, 0], A[0, 1], A[0, 2]
     d, e, f = A[1, 0], A[1, 1], A[1, 2]
@@ -246,7 +246,7 @@ def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
                 P[sj[s], r, c] -= C[s, r, c]
     Pinv = np.empty((n, 3, 3))
     for i in range(n):
-        _inv3(P[i], Pinv[i])
+        inv3(P[i], Pinv[i])
     for i in range(n):
         if fixed[i]:
             b[i, 0] = 0.0

@@ -46,6 +46,8 @@ class RigidBody(System):
         self.gravity = np.array(gravity, dtype=float).reshape(3)
         self.force = np.zeros(3)
         self.torque = np.zeros(3)
+        self.kext = np.zeros((3, 3))  # dF/dx (N/m) of the held force, when a contact gives it
+        self.dext = np.zeros((3, 3))  # dF/dv (N s/m)
         self._gx, self._gv = np.zeros(7), np.zeros(7)
 
     @property
@@ -55,19 +57,29 @@ class RigidBody(System):
     def clear_forces(self):
         self.force[:] = 0.0
         self.torque[:] = 0.0
+        self.kext[:] = 0.0
+        self.dext[:] = 0.0
 
-    def add_wrench(self, force, torque=None, point=None):
-        """Add a force (N) at a world point (m; default the centre) and an extra torque (N m)."""
+    def add_wrench(self, force, torque=None, point=None, dfdx=None, dfdv=None):
+        """Add a force (N) at a world point (m; default the centre) and an extra torque (N m).
+
+        dfdx (N/m) and dfdv (N s/m) are the force's 3x3 Jacobians with respect to the body's
+        position and velocity; with them a stiff force (a floor contact) is integrated
+        implicitly and stays stable at the body's step."""
         f = np.asarray(force, dtype=float)
         self.force += f
         if point is not None:
             self.torque += np.cross(np.asarray(point, dtype=float) - self.x, f)
         if torque is not None:
             self.torque += torque
+        if dfdx is not None:
+            self.kext += dfdx
+        if dfdv is not None:
+            self.dext += dfdv
 
     def step(self, h):
-        rigid_step(self.x, self.v, self.q, self.w, self.force, self.torque, self.gravity,
-                   self._mass, self.inertia_body, h)
+        rigid_step(self.x, self.v, self.q, self.w, self.force, self.torque, self.kext,
+                   self.dext, self.gravity, self._mass, self.inertia_body, h)
 
     def kinetic_energy(self):
         return kinetic_energy(self.v, self.q, self.w, self._mass, self.inertia_body)
