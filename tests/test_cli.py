@@ -15,7 +15,8 @@ def run_cli(capsys, *argv):
 
 def test_run_writes_summary_and_tracks(tmp_path, capsys):
     code, out, err = run_cli(capsys, "run", "basketball", "--coupling", "hybrid", "--duration",
-                             "0.7", "--out", str(tmp_path), "--quiet")
+                             "0.7", "--out", str(tmp_path), "--quiet", "--no-video", "--no-obj",
+                             "--no-usd", "--no-report")
     assert code == 0, err
     s = json.loads((tmp_path / "summary.json").read_text())
     for key in ("scene", "coupling", "duration_s", "systems", "timings", "interactions",
@@ -93,3 +94,11 @@ def test_unwritable_output_directory(capsys, tmp_path):
     code, _, err = run_cli(capsys, "run", "basketball", "--duration", "0.1", "--out",
                            str(blocker / "sub"), "--quiet")
     assert code == 2 and "cannot write" in err and len(err.strip().splitlines()) == 1
+
+
+def test_run_without_coupling_uses_the_scenes_own(tmp_path, capsys):
+    # the puddle's primary is animation: its scene defaults to one-way
+    code, _, err = run_cli(capsys, "run", "puddle", "--duration", "0.1", "--out", str(tmp_path),
+                           "--quiet", "--no-video", "--no-obj", "--no-usd", "--no-report")
+    assert code == 0, err
+    assert json.loads((tmp_path / "summary.json").read_text())["coupling"] == "one-way"

@@ -68,7 +68,8 @@ def _parser():
     sub.add_parser("list", help="list the scenes")
     run = sub.add_parser("run", help="simulate one scene in one coupling mode")
     _scene_options(run)
-    run.add_argument("--coupling", default="two-way", help="two-way | one-way | hybrid")
+    run.add_argument("--coupling", default=None,
+                     help="two-way | one-way | hybrid (default: the scene's own)")
     _output_options(run)
     cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
     _scene_options(cmp_)
@@ -105,14 +106,14 @@ def _build_kwargs(args):
 
 
 def _check_mode(mode):
-    if mode not in MODES:
+    if mode is not None and mode not in MODES:
         raise ParameterError(f"--coupling {mode}: unknown coupling; choose one of "
                              f"{', '.join(MODES)}")
 
 
 def _run_one(module, mode, kw, out, quiet, console, options=None):
     from .progress import PassProgress
-    scene = module.build(mode, **kw)
+    scene = module.build(mode, **kw) if mode else module.build(**kw)
     result = scene.simulate(progress=PassProgress(scene.duration, quiet))
     if options is None:
         return result, result.save(out)
