@@ -12,6 +12,8 @@ one-way with a ``StandIn`` acting on the primary in its own pass.
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 
 from ..errors import SceneError
@@ -19,17 +21,17 @@ from ..errors import SceneError
 MODES = ("two-way", "one-way", "hybrid")
 
 
-class StandIn:
+class StandIn(ABC):
     """A cheap substitute for an interaction that acts on the primary alone (hybrid coupling)."""
 
     name = "stand-in"
 
+    @abstractmethod
     def act(self, primary) -> tuple[np.ndarray, np.ndarray, bool]:
         """Apply the stand-in force to the primary; return (force N, torque N m, active)."""
-        raise NotImplementedError(f"{type(self).__name__} does not implement act()")
 
 
-class Interaction:
+class Interaction(ABC):
     """Base class: a named force exchange between ``primary`` and ``secondary``."""
 
     def __init__(self, name: str, primary, secondary, mode: str = "two-way",
@@ -57,16 +59,16 @@ class Interaction:
     def prepare(self, h: float) -> None:
         """Called at the start of each pass with its coupling step h (s)."""
 
+    @abstractmethod
     def exchange(self, to_primary: bool, to_secondary: bool):
         """Compute the forces, apply them where asked; return (force, torque, in_contact).
 
         An interaction that integrates its force over the secondary's substeps returns None
         instead; the scheduler then advances the secondary first and calls ``complete``."""
-        raise NotImplementedError(f"{type(self).__name__} does not implement exchange()")
 
     def complete(self, to_primary: bool):
         """Finish a deferred exchange after the secondary advanced; return as ``exchange``."""
-        raise NotImplementedError(f"{type(self).__name__} does not defer its exchange")
+        raise TypeError(f"{type(self).__name__} never defers its exchange")
 
     def describe(self) -> dict:
         return {"name": self.name, "primary": self.primary.name,

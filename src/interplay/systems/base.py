@@ -8,6 +8,8 @@ and velocities.
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 
 from ..errors import require_positive
@@ -15,7 +17,7 @@ from ..errors import require_positive
 GRAVITY = np.array([0.0, 0.0, -9.81])  # m/s^2, +z up
 
 
-class System:
+class System(ABC):
     """Base class of all simulations. Subclasses set ``kind`` and implement the state hooks.
 
     name: unique name within a scene.
@@ -41,9 +43,9 @@ class System:
     def clear_forces(self) -> None:
         """Forget the external forces of the last coupling step."""
 
+    @abstractmethod
     def step(self, h: float) -> None:
         """Advance by h seconds under the accumulated forces (held constant over h)."""
-        raise NotImplementedError(f"{type(self).__name__} does not implement step()")
 
     def advance(self, h: float) -> None:
         """Advance one coupling step of h seconds in ceil(h/dt) equal substeps."""
@@ -55,9 +57,9 @@ class System:
 
     # --- measured quantities ---------------------------------------------------------------
     @property
+    @abstractmethod
     def mass(self) -> float:
         """Total mass (kg); infinite for immovable systems."""
-        raise NotImplementedError
 
     def kinetic_energy(self) -> float:
         """Kinetic energy (J)."""
@@ -80,18 +82,18 @@ class System:
         return []
 
     # --- state for tracks, playback and checkpoints -----------------------------------------
+    @abstractmethod
     def generalized_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Flat (x, xdot) arrays of equal length describing the configuration and its rate.
         They may be views of the live state or reused buffers: copy them to keep them."""
-        raise NotImplementedError
 
+    @abstractmethod
     def set_generalized_state(self, x: np.ndarray, xdot: np.ndarray) -> None:
         """Impose (x, xdot) (used by playback; the system becomes kinematic for that pass)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def frame(self) -> dict[str, np.ndarray]:
         """What an output frame records (positions of a surface, or a pose)."""
-        raise NotImplementedError
 
     def capture(self) -> dict[str, np.ndarray]:
         """A full copy of the state, for restarting a pass."""
