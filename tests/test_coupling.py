@@ -140,11 +140,11 @@ def test_advisor_says_one_way_for_an_animated_primary():
     from interplay.analysis import advise
 
     class Animated:
-        name, accepts_forces = "foot", False
+        name, dynamic, accepts_forces = "foot", True, False
 
     class It:
         primary, standin = Animated(), None
 
     stats = {"primary": "foot", "acceleration_m_s2": {"min": 0.0, "max": 900.0, "mean": 500.0}}
     verdict = advise(stats, It())
-    assert verdict["mode"] == "one-way" and "animation" in verdict["reasons"][0]
+    assert verdict["mode"] == "one-way" and "prescribed" in verdict["reasons"][0]

@@ -78,10 +78,10 @@ def advise(stats: dict, interaction, one_way_stable: bool | None = None,
     one_way_stable: whether a one-way run of the secondary stayed stable (None: not measured).
     two_way_cost_s: wall time of a two-way run (None: not measured); expensive above the budget.
     """
-    if not getattr(interaction.primary, "accepts_forces", True):
+    if not (interaction.primary.dynamic and interaction.primary.accepts_forces):
         return {"mode": "one-way", "reasons": [
-            f"{stats['primary']} is animation (keyframes or motion capture): nothing can push "
-            "back on it, so only one-way coupling applies"]}
+            f"{stats['primary']} is prescribed (animation, motion capture or a field): nothing "
+            "can push back on it, so only one-way coupling applies"]}
     acc = stats["acceleration_m_s2"]
     ratio = acc["mean"] / G
     reasons = [f"effective acceleration on {stats['primary']} over contact: mean "

@@ -178,8 +178,7 @@ def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
         reports = {m: d / "report.html" for m, d in mode_dirs.items()
                    if (d / "report.html").exists()}
         files = {"compare.json": out / "compare.json"} if (out / "compare.json").exists() else {}
-        from .report_text import main_interaction
-        it = main_interaction(next(iter(results.values())))
+        it = next(iter(results.values())).scene.main_interaction
         pair = (it.primary.name, it.secondary.name) if it is not None else None
         written = write_compare_report(runs, out, rows, advice, video, reports, files, pair,
                                        st)

@@ -4,17 +4,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def main_interaction(result):
-    """The first interaction between two dynamic systems (the one Table I is about)."""
-    for it in result.scene.interactions:
-        if it.primary.dynamic and it.secondary.dynamic:
-            return it
-    return None
-
-
 def mode_row(result) -> dict:
     """The figures `compare` puts side by side for one run."""
-    it = main_interaction(result)
+    it = result.scene.main_interaction
     prim = result.scene.primary.name
     stats = next(s for s in result.interaction_stats() if s["name"] == it.name)
     row = {"coupling": it.mode, "force_N": stats["force_N"],

@@ -73,12 +73,10 @@ class Result:
         return [interaction_stats(self.logs[it.name]) for it in self.scene.interactions]
 
     def advice(self, one_way_stable=None, two_way_cost_s=None) -> dict:
-        """The advisor's verdict for the scene's main interaction (the first one between
-        dynamic systems)."""
-        main = [it for it in self.scene.interactions if it.primary.dynamic and it.secondary.dynamic]
-        if not main:
-            return {"mode": None, "reasons": ["no interaction between two dynamic systems"]}
-        it = main[0]
+        """The advisor's verdict for the scene's main interaction (Scene.main_interaction)."""
+        it = self.scene.main_interaction
+        if it is None:
+            return {"mode": None, "reasons": ["no interaction acts on a dynamic system"]}
         if one_way_stable is None and it.mode != "two-way":
             one_way_stable = not any(it.secondary.name in w for w in self.warnings)
         if two_way_cost_s is None and it.mode == "two-way":

@@ -56,9 +56,22 @@ class Scene:
 
     @property
     def coupling(self) -> str:
-        modes = sorted({it.mode for it in self.interactions
-                        if it.primary.dynamic and it.secondary.dynamic})
+        """The scene's coupling mode: that of every interaction acting on a dynamic secondary,
+        counted as one-way when the primary is prescribed (nothing can push back on it)."""
+        modes = sorted({it.effective_mode for it in self.interactions if it.secondary.dynamic})
         return modes[0] if len(modes) == 1 else ("mixed" if modes else "none")
+
+    @property
+    def main_interaction(self):
+        """The interaction Table I and the advisor are about: the first between two dynamic
+        systems, else the first driving a dynamic secondary from a moving primary (a wind)."""
+        for it in self.interactions:
+            if it.primary.dynamic and it.secondary.dynamic:
+                return it
+        for it in self.interactions:
+            if it.secondary.dynamic and it.primary.kind != "static":
+                return it
+        return None
 
     def simulate(self, progress=None, refine_unstable: bool = True, primary_only: bool = False):
         """Run all passes and return a Result (tracks, force logs, timings, diagnostics).

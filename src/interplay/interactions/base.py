@@ -56,6 +56,14 @@ class Interaction(ABC):
                              "(none is defined for it); use two-way or one-way")
         self._mode = mode
 
+    @property
+    def effective_mode(self) -> str:
+        """The mode as it acts: one-way whenever the primary is prescribed (static, a field,
+        animation), since nothing can push back on it."""
+        if not (self.primary.dynamic and self.primary.accepts_forces):
+            return "one-way"
+        return self.mode
+
     def prepare(self, h: float) -> None:
         """Called at the start of each pass with its coupling step h (s)."""
 
