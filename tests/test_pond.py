@@ -59,7 +59,8 @@ def test_pond_refuses_an_integrator():
 
 
 def test_puddle_splashes_one_way():
-    m, params = small("puddle", **{"basin.cells": "80"})
+    # the keyframed running step (no clip): it lands at 0.2 s
+    m, params = small("puddle", **{"basin.cells": "80", "clip": ""})
     scene = m.build("one-way", duration=0.6, fps=20, params=params)
     res = scene.simulate()
     assert [p.label for p in res.passes] == ["foot", "water"]
@@ -67,6 +68,28 @@ def test_puddle_splashes_one_way():
     assert d["peak_particles"] > 0 and d["volume_drift_rel"] < 1e-12
     foot = scene.primary
     np.testing.assert_allclose(res.state_at("foot", 0.4)[0], foot._path(0.4), atol=1e-12)
+
+
+def test_the_runners_foot_splashes_the_puddle():
+    from interplay.scenes.puddle import STANCE
+    from interplay.systems.mocap import clip_path
+    if not clip_path("cmu_02_03_run.bvh").exists():
+        pytest.skip("the CMU clips (../shared/data/mocap) are not here")
+    m, params = small("puddle", **{"basin.cells": "80"})
+    scene = m.build("one-way", duration=1.2, fps=20, params=params)
+    res = scene.simulate()
+    assert [p.label for p in res.passes] == ["runner", "foot", "water"]
+    runner = next(s for s in scene.systems if s.name == "runner")
+    names = [s.name for s in runner.plan]
+    # the foot follows the midpoint of the clip's right ankle and toes, shifted with the runner
+    t = 0.5 * sum(STANCE)
+    runner.set_time(t)
+    seg = runner.segment_positions()
+    mid = 0.5 * (seg[names.index("r_foot")] + seg[names.index("r_toes")])
+    # PCHIP between 120 Hz keys: within (v dt)^2 / L-ish of the clip; 1 mm is ample in stance
+    np.testing.assert_allclose(res.state_at("foot", t)[0][:3], mid, atol=1e-3)
+    d = res.summary()["diagnostics"]["water"]
+    assert d["peak_particles"] > 0 and d["volume_drift_rel"] < 1e-12
 
 
 def test_cli_runs_pond_and_writes_the_water_diagnostics(tmp_path, capsys):

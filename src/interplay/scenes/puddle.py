@@ -1,14 +1,18 @@
-"""A foot stepping in a shallow puddle (SPEC 4, the runner's splash), coupled one-way: the
-foot's motion is the animation's and stays unchanged; the water is pushed out from under it
-and splashes.
+"""A runner's foot stepping in a shallow puddle (SPEC 4, the runner's splash), coupled
+one-way: the foot's motion is the animation's and stays unchanged; the water is pushed out
+from under it and splashes.
 
-The foot is a keyframed ellipsoid (systems/kinematic.py) standing in for the runner: the CMU
-motion-capture run clip on the articulated figure will replace it when the BVH figure lands;
-the interaction (interactions/buoyancy.py) already takes any body with an ellipsoid shape.
+The runner is the CMU motion-capture jog (``clip``, from ../shared/data/mocap, played by a
+MocapFigure), placed so that its right foot's second stance lands in the middle of the puddle.
+The water feels an ellipsoid the size of a shoe that follows the midpoint of the clip's right
+ankle and toe joints (position only: it stays level, so heel strike and toe-off are not
+resolved). Without the clip the foot follows the keyframed running step of FootParams.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+
+import numpy as np
 
 from ..errors import ParameterError
 from ..geometry.basin import BasinParams, basin
@@ -16,6 +20,7 @@ from ..interactions.buoyancy import BodyInWater, BuoyancyParams
 from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
 from ..scene import Scene
 from ..systems.kinematic import KeyframedBody, KeyframedBodyParams
+from ..systems.mocap import MocapFigure, clip_path
 from ..systems.water import SprayParams, Water, WaterParams
 
 
@@ -48,10 +53,35 @@ class PuddleParams:
     buoyancy: BuoyancyParams = BuoyancyParams()
     field: ViscousDragFieldParams = ViscousDragFieldParams(linear=2.0, quadratic=20.0)
     coupling_dt: float = 2e-3  # s
+    clip: str = "cmu_02_03_run.bvh"  # the runner; "" (or no data folder): the keyframed foot
 
 
 PARAMS = PuddleParams
 STANDIN = "field"
+STANCE = (0.8, 1.1)  # s: the right foot's second stance in the jog clip
+
+
+def _runner(params: PuddleParams):
+    """(foot keyframes, the runner figure or None) from the clip, placed so that the right
+    foot's stance centre is over the puddle's middle, one semi-axis above the bed."""
+    path = clip_path(params.clip) if params.clip else None
+    if path is None or not path.exists():
+        return params.foot, None
+    clip = MocapFigure("runner", path)
+    names = [s.name for s in clip.plan]
+    t = np.arange(0.0, clip.duration, clip.motion.frame_time)
+    centre = np.empty((len(t), 3))
+    for k, tk in enumerate(t):
+        clip.set_time(tk)
+        seg = clip.segment_positions()
+        centre[k] = 0.5 * (seg[names.index("r_foot")] + seg[names.index("r_toes")])
+    stance = (t >= STANCE[0]) & (t <= STANCE[1])
+    low = np.argmin(np.where(stance, centre[:, 2], np.inf))
+    offset = np.array([-centre[low, 0], -centre[low, 1],
+                       params.foot.semi_axes[2] - centre[low, 2]])
+    keys = centre + offset
+    foot = replace(params.foot, times=tuple(t), positions=tuple(keys.ravel()))
+    return foot, MocapFigure("runner", path, position_offset=tuple(offset))
 
 
 def build(coupling: str = "one-way", duration: float = 1.5, fps: float = 60.0,
@@ -65,7 +95,10 @@ def build(coupling: str = "one-way", duration: float = 1.5, fps: float = 60.0,
     wp = params.water if dt is None else replace(params.water, dt=dt)
     geo = basin(params.basin)
     scene = Scene("puddle", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
-    foot = scene.add(KeyframedBody("foot", params.foot))
+    foot_params, runner = _runner(params)
+    if runner is not None:
+        scene.add(runner)
+    foot = scene.add(KeyframedBody("foot", foot_params))
     water = scene.add(Water("water", geo.bed, geo.fluid, geo.depth, geo.spacing, geo.origin,
                             wp))
     a = params.foot.semi_axes

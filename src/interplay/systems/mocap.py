@@ -75,6 +75,7 @@ class MocapFigure(System):
     frame whose rotations are all zero (the T-pose the cgspeed conversion adds)."""
 
     kind = "mocap"
+    accepts_forces = False
     integrator = "retargeted BVH clip, cubic spline playback"
 
     def __init__(self, name: str, path, mass: float = 75.0, units: str | None = None,
@@ -173,6 +174,11 @@ class MocapFigure(System):
 
     def add_wrench(self, force, torque=None, point=None, body=0):
         """Forces are ignored: the clip drives the figure."""
+
+    def set_time(self, t: float):
+        """Pose the figure as the clip is at time t (s), clamped to the clip."""
+        self.time = float(t)
+        self._sample(self.time)
 
     def _sample(self, t):
         t = min(max(t, 0.0), self.duration)
