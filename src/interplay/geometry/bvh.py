@@ -1,0 +1,124 @@
+"""Bounding-volume hierarchies of triangle (or segment) sets: build once, refit deforming
+objects, transform rigid ones, and query (SPEC 2.5 detection; kernels in kernels/bvh.py).
+
+Not to be confused with io/bvh.py, the Biovision Hierarchy motion-capture reader.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..kernels import bvh as K
+from ..kernels.trimesh_contact import edge_pairs_within, intersecting_pairs
+
+
+def check_points(owner: str, x, what: str = "positions") -> np.ndarray:
+    """x as a float (n,3) array, or ParameterError naming the first non-finite point."""
+    x = np.ascontiguousarray(x, dtype=float)
+    if x.ndim != 2 or x.shape[1] != 3:
+        raise ParameterError(f"{owner}: {what} must be an (n,3) array, got shape {x.shape}")
+    bad = np.flatnonzero(~np.all(np.isfinite(x), axis=1))
+    if len(bad):
+        raise ParameterError(f"{owner}: {what} of point {bad[0]} is not finite ({x[bad[0]]}); "
+                             "the simulation blew up or the input is broken: fix the input or "
+                             "reduce the step")
+    return x
+
+
+def check_thickness(owner: str, thickness) -> float:
+    t = float(thickness)
+    if not (t >= 0.0) or not np.isfinite(t):
+        raise ParameterError(f"{owner}: contact thickness must be zero or positive (m), got "
+                             f"{thickness!r}; use e.g. 0.005 for cloth")
+    return t
+
+
+class BVH:
+    """A hierarchy over elements (rows of vertex indices: (m,3) triangles or (m,2) segments)
+    of a vertex set (n,3) m. Boxes are grown by ``pad`` (m) and span the motion of the step."""
+
+    def __init__(self, vertices, elements, owner: str = "mesh", pad: float = 0.0):
+        self.owner = owner
+        x = check_points(owner, vertices, "vertices")
+        e = np.ascontiguousarray(elements, dtype=np.int64)
+        if e.ndim != 2 or e.shape[0] == 0 or e.shape[1] not in (1, 2, 3):
+            raise ParameterError(f"{owner}: a collision mesh needs at least one triangle or "
+                                 f"segment, got elements of shape {e.shape}; give the object a "
+                                 "surface or leave it out of collisions")
+        if e.min() < 0 or e.max() >= len(x):
+            raise ParameterError(f"{owner}: element indices must be in 0..{len(x) - 1}, got "
+                                 f"{e.min()}..{e.max()}")
+        self.elements = e
+        self.pad = check_thickness(owner, pad)
+        self.left, self.right, self.prim = K.build(x, e)
+        nn = len(self.prim)
+        self.lo, self.hi = np.zeros((nn, 3)), np.zeros((nn, 3))
+        self.x = x
+        self.refit(x)
+        # body-frame boxes, kept so a rigid object's tree is transformed, never rebuilt
+        self.lo0, self.hi0 = self.lo.copy(), self.hi.copy()
+        self.body_x = x.copy()
+
+    def refit(self, x, x_end=None):
+        """Refit every box to vertices x (and x_end, the positions at the end of the step)."""
+        self.x = check_points(self.owner, x)
+        x1 = self.x if x_end is None else check_points(self.owner, x_end)
+        K.refit(self.lo, self.hi, self.left, self.right, self.prim, self.elements, self.x, x1,
+                self.pad)
+
+    def transform(self, R, t, R_end=None, t_end=None):
+        """Rigid motion: world boxes from the body-frame boxes at pose (R, t) (and the pose at
+        the end of the step); ``self.x`` becomes the world vertices at (R, t)."""
+        R = np.ascontiguousarray(R, dtype=float)
+        t = np.ascontiguousarray(t, dtype=float)
+        R1 = R if R_end is None else np.ascontiguousarray(R_end, dtype=float)
+        t1 = t if t_end is None else np.ascontiguousarray(t_end, dtype=float)
+        K.transform_boxes(self.lo0, self.hi0, R, t, R1, t1, 0.0, self.lo, self.hi)
+        self.x = self.body_x @ R.T + t
+
+    def nearest(self, points, radius: float, skip_incident: bool = False):
+        """For each point (n,3): nearest triangle within radius (m) of it (-1 if none), the
+        distance (m) and the barycentric weights of the closest point."""
+        if self.elements.shape[1] != 3:
+            raise ParameterError(f"{self.owner}: nearest-triangle queries need triangles")
+        p = check_points(self.owner, points, "query points")
+        n = len(p)
+        tri, d, bary = np.empty(n, np.int64), np.empty(n), np.empty((n, 3))
+        K.nearest_triangles(p, float(radius), self.lo, self.hi, self.left, self.right, self.prim,
+                            self.elements, self.x, skip_incident, tri, d, bary)
+        return tri, d, bary
+
+    def overlapping(self, other: "BVH | None" = None) -> np.ndarray:
+        """(k,2) element pairs whose boxes overlap: this tree against another, or against itself
+        (each unordered pair once) when other is None."""
+        o = self if other is None else other
+        out = np.empty((max(64, 4 * len(self.elements)), 2), np.int64)
+        while True:
+            n = K.overlap_pairs(self.lo, self.hi, self.left, self.right, self.prim, o.lo, o.hi,
+                                o.left, o.right, o.prim, other is None, out)
+            if n <= len(out):
+                return out[:n].copy()
+            out = np.empty((n, 2), np.int64)
+
+    def intersections(self, other: "BVH | None" = None) -> np.ndarray:
+        """(k,2) pairs of triangles that interpenetrate (self-intersections when other is None,
+        skipping triangles that share a vertex)."""
+        o = self if other is None else other
+        pairs = self.overlapping(other)
+        if other is None and len(pairs):
+            e = self.elements
+            share = (e[pairs[:, 0], :, None] == e[pairs[:, 1], None, :]).any(axis=(1, 2))
+            pairs = pairs[~share]
+        hit = np.zeros(len(pairs), np.bool_)
+        intersecting_pairs(self.x, self.elements, o.x, o.elements, pairs, hit)
+        return pairs[hit]
+
+    def edge_contacts(self, other: "BVH", reach: float):
+        """Segment pairs of two segment trees closer than reach (m): (pairs (k,2), closest-point
+        parameters (k,2), distances (k,))."""
+        pairs = self.overlapping(other)
+        st, d = np.empty((len(pairs), 2)), np.empty(len(pairs))
+        edge_pairs_within(self.x, self.elements, other.x, other.elements, pairs, float(reach),
+                          st, d)
+        keep = np.isfinite(d)
+        return pairs[keep], st[keep], d[keep]

@@ -1,0 +1,223 @@
+"""Bounding-volume hierarchies of elements (triangles, segments or points) and their queries
+(SPEC 2.5 detection, after Snyder).
+
+A tree is five arrays: ``lo``, ``hi`` (nodes, 3) axis-aligned boxes (m), ``left``, ``right``
+(nodes,) child node indices and ``prim`` (nodes,) the element held by a leaf (-1 for interior
+nodes). Every leaf holds one element; children are numbered after their parent, so a refit
+walks the nodes backwards. Elements are rows of vertex indices: (m,3) triangles, (m,2)
+segments, (m,1) points. Traversals use an explicit stack (no recursion in Numba).
+"""
+import numpy as np
+from numba import njit, prange
+
+from .trimesh_contact import closest_on_triangle
+
+STACK = 96  # deeper than any median-split tree of < 2^40 elements (depth ~ log2 m + 1)
+
+
+@njit(cache=True)
+def build(x, elems):
+    """Top-down build: split at the median centroid along the widest centroid axis.
+
+    Returns (left, right, prim); boxes are filled by ``refit``. 2m-1 nodes."""
+    m = elems.shape[0]
+    k = elems.shape[1]
+    cen = np.zeros((m, 3))
+    for e in range(m):
+        for j in range(k):
+            for r in range(3):
+                cen[e, r] += x[elems[e, j], r] / k
+    nn = 2 * m - 1
+    left = -np.ones(nn, np.int64)
+    right = -np.ones(nn, np.int64)
+    prim = -np.ones(nn, np.int64)
+    order = np.arange(m)
+    # stack of (node, start, end) over order[start:end]
+    st = np.zeros((STACK, 3), np.int64)
+    st[0, 0], st[0, 1], st[0, 2] = 0, 0, m
+    top = 1
+    nxt = 1
+    while top > 0:
+        top -= 1
+        node, s, t = st[top, 0], st[top, 1], st[top, 2]
+        if t - s == 1:
+            prim[node] = order[s]
+            continue
+        lo = np.full(3, np.inf)
+        hi = np.full(3, -np.inf)
+        for i in range(s, t):
+            for r in range(3):
+                c = cen[order[i], r]
+                lo[r] = min(lo[r], c)
+                hi[r] = max(hi[r], c)
+        ax = int(np.argmax(hi - lo))
+        keys = np.empty(t - s)
+        for i in range(s, t):
+            keys[i - s] = cen[order[i], ax]
+        srt = np.argsort(keys, kind="mergesort")
+        seg = order[s:t].copy()
+        for i in range(t - s):
+            order[s + i] = seg[srt[i]]
+        mid = (s + t) // 2
+        left[node], right[node] = nxt, nxt + 1
+        nxt += 2
+        st[top, 0], st[top, 1], st[top, 2] = left[node], s, mid
+        st[top + 1, 0], st[top + 1, 1], st[top + 1, 2] = right[node], mid, t
+        top += 2
+    return left, right, prim
+
+
+@njit(cache=True)
+def refit(lo, hi, left, right, prim, elems, x0, x1, pad):
+    """Boxes of every node: each leaf bounds its element at both x0 and x1 (the start and end of
+    the step, so a contact during the step is not missed), grown by pad (m); interior nodes
+    bound their children."""
+    k = elems.shape[1]
+    for node in range(lo.shape[0] - 1, -1, -1):
+        e = prim[node]
+        if e >= 0:
+            for r in range(3):
+                a = np.inf
+                b = -np.inf
+                for j in range(k):
+                    p = elems[e, j]
+                    a = min(a, x0[p, r], x1[p, r])
+                    b = max(b, x0[p, r], x1[p, r])
+                lo[node, r] = a - pad
+                hi[node, r] = b + pad
+        else:
+            ln, rn = left[node], right[node]
+            for r in range(3):
+                lo[node, r] = min(lo[ln, r], lo[rn, r])
+                hi[node, r] = max(hi[ln, r], hi[rn, r])
+
+
+@njit(cache=True)
+def transform_boxes(lo0, hi0, R0, t0, R1, t1, pad, lo, hi):
+    """World boxes of a rigid body's body-frame boxes (lo0, hi0) without rebuilding or refitting:
+    each box is rotated (centre R c + t, half-extent |R| e) at the step's start pose (R0, t0)
+    and end pose (R1, t1), and the union grown by pad (m)."""
+    for node in range(lo0.shape[0]):
+        for r in range(3):
+            lo[node, r] = np.inf
+            hi[node, r] = -np.inf
+        for pose in range(2):
+            R = R0 if pose == 0 else R1
+            t = t0 if pose == 0 else t1
+            for r in range(3):
+                c = t[r]
+                e = 0.0
+                for j in range(3):
+                    cj = 0.5 * (lo0[node, j] + hi0[node, j])
+                    ej = 0.5 * (hi0[node, j] - lo0[node, j])
+                    c += R[r, j] * cj
+                    e += abs(R[r, j]) * ej
+                lo[node, r] = min(lo[node, r], c - e - pad)
+                hi[node, r] = max(hi[node, r], c + e + pad)
+
+
+@njit(cache=True, inline="always")
+def _box_dist2(p, lo, hi, node):
+    d2 = 0.0
+    for r in range(3):
+        if p[r] < lo[node, r]:
+            d2 += (lo[node, r] - p[r]) ** 2
+        elif p[r] > hi[node, r]:
+            d2 += (p[r] - hi[node, r]) ** 2
+    return d2
+
+
+@njit(cache=True, parallel=True)
+def nearest_triangles(pts, radius, lo, hi, left, right, prim, tris, x, skip_incident,
+                      out_tri, out_d, out_bary):
+    """For each point, the nearest triangle within radius (m) of it: index (-1 if none),
+    distance (m) and barycentric weights of the closest point. skip_incident: ignore triangles
+    having the point (same index) as a vertex (a network against itself). Race-free: each
+    point writes only its own row."""
+    for i in prange(pts.shape[0]):
+        p = pts[i]
+        best = radius * radius
+        bt = -1
+        b0, b1, b2 = 0.0, 0.0, 0.0
+        st = np.empty(STACK, np.int64)
+        st[0] = 0
+        top = 1
+        while top > 0:
+            top -= 1
+            node = st[top]
+            if _box_dist2(p, lo, hi, node) > best:
+                continue
+            e = prim[node]
+            if e < 0:
+                st[top] = left[node]
+                st[top + 1] = right[node]
+                top += 2
+                continue
+            ia, ib, ic = tris[e, 0], tris[e, 1], tris[e, 2]
+            if skip_incident and (ia == i or ib == i or ic == i):
+                continue
+            u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
+            if d2 <= best:
+                best, bt, b0, b1, b2 = d2, e, u, v, w
+        out_tri[i] = bt
+        out_d[i] = np.sqrt(best) if bt >= 0 else np.inf
+        out_bary[i, 0], out_bary[i, 1], out_bary[i, 2] = b0, b1, b2
+
+
+@njit(cache=True, inline="always")
+def _overlap(loa, hia, a, lob, hib, b):
+    for r in range(3):
+        if loa[a, r] > hib[b, r] or lob[b, r] > hia[a, r]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def overlap_pairs(loa, hia, lefta, righta, prima, lob, hib, leftb, rightb, primb, self_tree,
+                  out):
+    """Element pairs (ea, eb) of two trees whose leaf boxes overlap, by descending both trees
+    from the roots. self_tree: the same tree twice; each unordered pair once, no element with
+    itself. Writes up to len(out) pairs; returns the total count (call again with a larger out
+    when it exceeds it)."""
+    cap = out.shape[0]
+    n = 0
+    st = np.empty((4 * STACK, 2), np.int64)
+    st[0, 0], st[0, 1] = 0, 0
+    top = 1
+    while top > 0:
+        top -= 1
+        a, b = st[top, 0], st[top, 1]
+        if not _overlap(loa, hia, a, lob, hib, b):
+            continue
+        ea, eb = prima[a], primb[b]
+        if ea >= 0 and eb >= 0:
+            if not (self_tree and a == b):
+                if n < cap:
+                    out[n, 0], out[n, 1] = ea, eb
+                n += 1
+            continue
+        if top + 4 > st.shape[0]:
+            grown = np.empty((2 * st.shape[0], 2), np.int64)
+            grown[:top] = st[:top]
+            st = grown
+        # descend the interior node with the larger box (both when it is the same node)
+        if self_tree and a == b:
+            la, ra = lefta[a], righta[a]
+            st[top, 0], st[top, 1] = la, la
+            st[top + 1, 0], st[top + 1, 1] = la, ra
+            st[top + 2, 0], st[top + 2, 1] = ra, ra
+            top += 3
+            continue
+        va = 0.0
+        vb = 0.0
+        for r in range(3):
+            va += hia[a, r] - loa[a, r]
+            vb += hib[b, r] - lob[b, r]
+        if eb >= 0 or (ea < 0 and va >= vb):
+            st[top, 0], st[top, 1] = lefta[a], b
+            st[top + 1, 0], st[top + 1, 1] = righta[a], b
+        else:
+            st[top, 0], st[top, 1] = a, leftb[b]
+            st[top + 1, 0], st[top + 1, 1] = a, rightb[b]
+        top += 2
+    return n

@@ -1,0 +1,264 @@
+"""Contact geometry and response for triangle meshes and simple shapes (SPEC 2.5).
+
+Geometry: the closest point of a triangle, closest points of two segments, whether two
+triangles intersect, signed distances to a plane, box, sphere and capsule.
+Response (per contact): normal force f_n = f_c + c_s p - c_d pdot, clamped at zero (contacts
+push, never pull), where p is the penetration (m), pdot its rate, and f_c the constraint term
+that cancels the relative acceleration pushing the two together, f_c = -m_eff min(0, a_rel.n);
+friction is regularized Coulomb, -mu f_n min(1, |v_t|/eps) v_t/|v_t|, capped at the force that
+stops the slip within the step, and becomes static (the force that stops slip, including the
+other forces' pull) while that stays inside the cone mu f_n: a block on a slope flatter than
+atan(mu) then sticks instead of creeping at the regularization's speed.
+"""
+import numpy as np
+from numba import njit, prange
+
+
+@njit(cache=True)
+def closest_on_triangle(p, a, b, c):
+    """Barycentric weights (u, v, w) of the point of triangle abc closest to p, and the squared
+    distance (Ericson, Real-Time Collision Detection 5.1.5: Voronoi regions of the features)."""
+    ab = b - a
+    ac = c - a
+    ap = p - a
+    d1 = ab @ ap
+    d2 = ac @ ap
+    if d1 <= 0.0 and d2 <= 0.0:
+        u, v, w = 1.0, 0.0, 0.0
+    else:
+        bp = p - b
+        d3 = ab @ bp
+        d4 = ac @ bp
+        vc = d1 * d4 - d3 * d2
+        if d3 >= 0.0 and d4 <= d3:
+            u, v, w = 0.0, 1.0, 0.0
+        elif vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+            t = d1 / (d1 - d3)
+            u, v, w = 1.0 - t, t, 0.0
+        else:
+            cp = p - c
+            d5 = ab @ cp
+            d6 = ac @ cp
+            vb = d5 * d2 - d1 * d6
+            va = d3 * d6 - d5 * d4
+            if d6 >= 0.0 and d5 <= d6:
+                u, v, w = 0.0, 0.0, 1.0
+            elif vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+                t = d2 / (d2 - d6)
+                u, v, w = 1.0 - t, 0.0, t
+            elif va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+                t = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+                u, v, w = 0.0, 1.0 - t, t
+            else:
+                den = va + vb + vc
+                v = vb / den
+                w = vc / den
+                u = 1.0 - v - w
+    q = u * a + v * b + w * c
+    d = p - q
+    return u, v, w, d @ d
+
+
+@njit(cache=True)
+def closest_segments(p1, q1, p2, q2):
+    """Parameters (s, t) in [0,1] of the closest points p1 + s (q1-p1), p2 + t (q2-p2) of two
+    segments and their squared distance (Ericson 5.1.9; parallel segments handled)."""
+    d1 = q1 - p1
+    d2 = q2 - p2
+    r = p1 - p2
+    a = d1 @ d1
+    e = d2 @ d2
+    f = d2 @ r
+    tiny = 1e-30
+    if a <= tiny and e <= tiny:
+        s, t = 0.0, 0.0
+    elif a <= tiny:
+        s, t = 0.0, min(1.0, max(0.0, f / e))
+    else:
+        c = d1 @ r
+        if e <= tiny:
+            s, t = min(1.0, max(0.0, -c / a)), 0.0
+        else:
+            b = d1 @ d2
+            den = a * e - b * b
+            s = min(1.0, max(0.0, (b * f - c * e) / den)) if den > 1e-14 * a * e else 0.0
+            t = (b * s + f) / e
+            if t < 0.0:
+                t, s = 0.0, min(1.0, max(0.0, -c / a))
+            elif t > 1.0:
+                t, s = 1.0, min(1.0, max(0.0, (b - c) / a))
+    d = (p1 + s * d1) - (p2 + t * d2)
+    return s, t, d @ d
+
+
+@njit(cache=True, inline="always")
+def _orient(a, b, c, d):
+    """Six times the signed volume of tetrahedron abcd (> 0: d above the plane abc)."""
+    return np.dot(np.cross(b - a, c - a), d - a)
+
+
+@njit(cache=True)
+def _edge_hits(p, q, a, b, c):
+    o1 = _orient(a, b, c, p)
+    o2 = _orient(a, b, c, q)
+    if (o1 > 0.0 and o2 > 0.0) or (o1 < 0.0 and o2 < 0.0) or (o1 == 0.0 and o2 == 0.0):
+        return False
+    s1 = _orient(p, q, a, b)
+    s2 = _orient(p, q, b, c)
+    s3 = _orient(p, q, c, a)
+    return (s1 >= 0.0 and s2 >= 0.0 and s3 >= 0.0) or (s1 <= 0.0 and s2 <= 0.0 and s3 <= 0.0)
+
+
+@njit(cache=True)
+def triangles_intersect(a0, a1, a2, b0, b1, b2):
+    """True when two non-coplanar triangles (closed sets) intersect: then an edge of one
+    crosses the other (the intersection segment ends on the triangles' boundaries). Coplanar
+    pairs report False: they touch without interpenetrating, which the proximity contacts
+    handle."""
+    return (_edge_hits(a0, a1, b0, b1, b2) or _edge_hits(a1, a2, b0, b1, b2)
+            or _edge_hits(a2, a0, b0, b1, b2) or _edge_hits(b0, b1, a0, a1, a2)
+            or _edge_hits(b1, b2, a0, a1, a2) or _edge_hits(b2, b0, a0, a1, a2))
+
+
+@njit(cache=True, parallel=True)
+def intersecting_pairs(xa, ta, xb, tb, pairs, out):
+    """out[i] = whether triangle pairs[i,0] of mesh a intersects pairs[i,1] of mesh b."""
+    for i in prange(pairs.shape[0]):
+        s, t = ta[pairs[i, 0]], tb[pairs[i, 1]]
+        out[i] = triangles_intersect(xa[s[0]], xa[s[1]], xa[s[2]], xb[t[0]], xb[t[1]], xb[t[2]])
+
+
+@njit(cache=True)
+def edge_pairs_within(xa, ea, xb, eb, pairs, reach, out_st, out_d):
+    """Closest points (s, t) and distance of segment pairs (pairs[i] = (ea row, eb row));
+    distance inf when farther than reach (m)."""
+    for i in range(pairs.shape[0]):
+        u, w = ea[pairs[i, 0]], eb[pairs[i, 1]]
+        s, t, d2 = closest_segments(xa[u[0]], xa[u[1]], xb[w[0]], xb[w[1]])
+        out_st[i, 0], out_st[i, 1] = s, t
+        out_d[i] = np.sqrt(d2) if d2 <= reach * reach else np.inf
+
+
+@njit(cache=True, parallel=True)
+def signed_triangle_distance(pts, tri, bary, dist, x, tris, signed, out_s, out_n):
+    """Signed distance and outward contact normal of each point from its nearest triangle
+    (tri[i] >= 0, closest point given by bary). signed: the triangle's winding gives its
+    outside (closed or one-sided meshes: a point behind the face is inside, s < 0); otherwise
+    the normal points from the triangle to the point, s = distance."""
+    for i in prange(pts.shape[0]):
+        e = tri[i]
+        if e < 0:
+            continue
+        a, b, c = x[tris[e, 0]], x[tris[e, 1]], x[tris[e, 2]]
+        fn = np.cross(b - a, c - a)
+        fn = fn / np.sqrt(fn @ fn)
+        q = bary[i, 0] * a + bary[i, 1] * b + bary[i, 2] * c
+        u = pts[i] - q
+        d = dist[i]
+        if d > 1e-9 * (1.0 + np.sqrt((b - a) @ (b - a))):
+            u = u / d
+            if signed and u @ fn < 0.0:
+                out_s[i] = -d
+                out_n[i] = -u
+            else:
+                out_s[i] = d
+                out_n[i] = u
+        else:
+            out_s[i] = 0.0
+            out_n[i] = fn
+
+
+@njit(cache=True, parallel=True)
+def box_distance(pts, centre, R, half, out_s, out_n):
+    """Signed distance (m) and outward normal of points from a box (centre, rotation R whose
+    columns are its axes, half extents)."""
+    for i in prange(pts.shape[0]):
+        loc = R.T @ (pts[i] - centre)
+        q = np.abs(loc) - half
+        if q.max() > 0.0:
+            cl = np.maximum(q, 0.0)
+            d = np.sqrt(cl @ cl)
+            g = np.sign(loc) * cl / d
+            out_s[i] = d
+        else:
+            ax = int(np.argmax(q))
+            g = np.zeros(3)
+            g[ax] = 1.0 if loc[ax] >= 0.0 else -1.0
+            out_s[i] = q[ax]
+        out_n[i] = R @ g
+
+
+@njit(cache=True, parallel=True)
+def capsule_distance(pts, a, b, radius, out_s, out_n):
+    """Signed distance (m) and outward normal of points from a capsule (segment ab, radius m);
+    a == b is a sphere."""
+    ab = b - a
+    L2 = ab @ ab
+    for i in prange(pts.shape[0]):
+        t = 0.0 if L2 <= 0.0 else min(1.0, max(0.0, ((pts[i] - a) @ ab) / L2))
+        u = pts[i] - (a + t * ab)
+        d = np.sqrt(u @ u)
+        out_s[i] = d - radius
+        if d > 0.0:
+            out_n[i] = u / d
+        else:
+            out_n[i, 0], out_n[i, 1], out_n[i, 2] = 0.0, 0.0, 1.0
+
+
+@njit(cache=True)
+def respond(nrm, pen, vrel, arel, inv_m, stiffness, damping, omega, mu, eps, dt, constraint,
+            out_f, out_jx, out_jv):
+    """Forces on the point side of each contact (normal nrm towards it, penetration pen m,
+    relative velocity vrel and acceleration arel of the point side, inverse effective mass
+    inv_m 1/kg). stiffness (N/m) and damping (N s/m) < 0 choose them from the pair's mass and
+    the step: c_s = m_eff omega^2, c_d = 2 m_eff omega (critically damped: no bounce), omega
+    (rad/s) well below 1/dt so the held force stays stable. Writes force and its 3x3
+    Jacobians (d/dx, d/dv of the point side); returns the active mask."""
+    nc = nrm.shape[0]
+    active = np.zeros(nc, np.bool_)
+    for i in range(nc):
+        n = nrm[i]
+        meff = 1.0 / inv_m[i]
+        cs = stiffness if stiffness >= 0.0 else meff * omega * omega
+        cd = damping if damping >= 0.0 else 2.0 * meff * omega
+        vn = vrel[i] @ n
+        an = arel[i] @ n
+        fn = cs * pen[i] - cd * vn
+        if constraint and an < 0.0:
+            fn -= meff * an
+        out_f[i] = 0.0
+        out_jx[i] = 0.0
+        out_jv[i] = 0.0
+        if fn <= 0.0:
+            continue
+        active[i] = True
+        vt = vrel[i] - vn * n
+        at = arel[i] - an * n
+        vtn = np.sqrt(vt @ vt)
+        cap = mu * fn
+        visc = 0.0
+        if dt > 0.0:
+            req = -meff * (vt / dt + at)
+            reqn = np.sqrt(req @ req)
+        else:
+            req = np.zeros(3)
+            reqn = np.inf
+        if reqn <= cap:
+            ft = req  # static: stops the slip within the step, inside the friction cone
+            visc = meff / dt
+        elif vtn > 0.0:
+            fmag = cap * min(1.0, vtn / eps)
+            if dt > 0.0:
+                fmag = min(fmag, meff * vtn / dt)
+            ft = -fmag / vtn * vt
+            if vtn < eps:
+                visc = cap / eps
+        else:
+            ft = np.zeros(3)
+        out_f[i] = fn * n + ft
+        for a in range(3):
+            for b in range(3):
+                nn = n[a] * n[b]
+                out_jx[i, a, b] = -cs * nn
+                out_jv[i, a, b] = -cd * nn - visc * ((1.0 if a == b else 0.0) - nn)
+    return active
