@@ -5,10 +5,11 @@ triangles intersect, signed distances to a plane, box, sphere and capsule.
 Response (per contact): normal force f_n = f_c + c_s p - c_d pdot, clamped at zero (contacts
 push, never pull), where p is the penetration (m), pdot its rate, and f_c the constraint term
 that cancels the relative acceleration pushing the two together, f_c = -m_eff min(0, a_rel.n);
-friction is regularized Coulomb, -mu f_n min(1, |v_t|/eps) v_t/|v_t|, capped at the force that
-stops the slip within the step, and becomes static (the force that stops slip, including the
-other forces' pull) while that stays inside the cone mu f_n: a block on a slope flatter than
-atan(mu) then sticks instead of creeping at the regularization's speed.
+friction is Coulomb: mu f_n against the slip while sliding (the regularized law
+-mu f_n min(1, |v_t|/eps) v_t/|v_t| above eps), and static below the cone: a tangential spring
+to where the contact stuck, with the normal's stiffness and damping, which replaces the
+regularization's viscous range (there a block on a slope flatter than atan(mu) would creep at
+~eps tan(theta)/mu instead of sticking).
 """
 import numpy as np
 from numba import njit, prange
@@ -207,13 +208,14 @@ def capsule_distance(pts, a, b, radius, out_s, out_n):
 
 @njit(cache=True)
 def respond(nrm, pen, vrel, arel, inv_m, stiffness, damping, omega, mu, eps, dt, constraint,
-            out_f, out_jx, out_jv):
+            stretch, out_f, out_jx, out_jv):
     """Forces on the point side of each contact (normal nrm towards it, penetration pen m,
     relative velocity vrel and acceleration arel of the point side, inverse effective mass
     inv_m 1/kg). stiffness (N/m) and damping (N s/m) < 0 choose them from the pair's mass and
     the step: c_s = m_eff omega^2, c_d = 2 m_eff omega (critically damped: no bounce), omega
-    (rad/s) well below 1/dt so the held force stays stable. Writes force and its 3x3
-    Jacobians (d/dx, d/dv of the point side); returns the active mask."""
+    (rad/s) well below 1/dt so the held force stays stable. stretch (c,3) m: each contact's
+    tangential spring stretch, updated in place (zero for a new contact). Writes force and its
+    3x3 Jacobians (d/dx, d/dv of the point side); returns the active mask."""
     nc = nrm.shape[0]
     active = np.zeros(nc, np.bool_)
     for i in range(nc):
@@ -233,32 +235,36 @@ def respond(nrm, pen, vrel, arel, inv_m, stiffness, damping, omega, mu, eps, dt,
             continue
         active[i] = True
         vt = vrel[i] - vn * n
-        at = arel[i] - an * n
         vtn = np.sqrt(vt @ vt)
         cap = mu * fn
+        # stick: a tangential spring from where the contact first held (stretch[i], kept by
+        # the caller per point), with the normal's stiffness and damping. The stretch is shared
+        # by all contacts of a rigid body, so contacts far from their cap take up the load
+        # those at it cannot: a block sticks whenever the total friction mu N suffices.
+        u = stretch[i] - (stretch[i] @ n) * n + dt * vt
+        g = cs * u + cd * vt
+        gn = np.sqrt(g @ g)
         visc = 0.0
-        if dt > 0.0:
-            req = -meff * (vt / dt + at)
-            reqn = np.sqrt(req @ req)
+        if gn <= cap:
+            ft = -g
+            stick = cs
+            visc = cd
         else:
-            req = np.zeros(3)
-            reqn = np.inf
-        if reqn <= cap:
-            ft = req  # static: stops the slip within the step, inside the friction cone
-            visc = meff / dt
-        elif vtn > 0.0:
-            fmag = cap * min(1.0, vtn / eps)
-            if dt > 0.0:
-                fmag = min(fmag, meff * vtn / dt)
-            ft = -fmag / vtn * vt
+            # slip: Coulomb at the cone, opposing the spring and the slip (for steady sliding
+            # -mu f_n v_t/|v_t|, the regularized law above eps). Below eps the regularized
+            # law's viscous force mu f_n |v_t|/eps would let a loaded contact creep at that
+            # speed; the stick spring, saturated here, takes its place.
+            stick = 0.0
+            ft = -cap / gn * g
             if vtn < eps:
-                visc = cap / eps
-        else:
-            ft = np.zeros(3)
+                visc = min(cap / eps, meff / dt) if dt > 0.0 else cap / eps
+            u = g * (cap / (gn * cs)) if cs > 0.0 else np.zeros(3)  # the spring at its limit
+        stretch[i] = u
         out_f[i] = fn * n + ft
         for a in range(3):
             for b in range(3):
                 nn = n[a] * n[b]
-                out_jx[i, a, b] = -cs * nn
-                out_jv[i, a, b] = -cd * nn - visc * ((1.0 if a == b else 0.0) - nn)
+                tan = (1.0 if a == b else 0.0) - nn
+                out_jx[i, a, b] = -cs * nn - stick * tan
+                out_jv[i, a, b] = -cd * nn - visc * tan
     return active
