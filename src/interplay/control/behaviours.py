@@ -11,13 +11,14 @@ from .fsm import State, Transition
 STANCE_BALANCE = (0.5, 0.2)  # rad/m, rad s/m: centre-of-mass feedback while standing
 
 
-def stand(name="stand", next=None, after=1.0, balance=STANCE_BALANCE) -> State:
-    """Upright on both feet, knees soft, centre of mass kept over the feet."""
+def stand(name="stand", next=None, after=1.0, balance=STANCE_BALANCE, blend=0.6) -> State:
+    """Upright on both feet, knees soft, centre of mass kept over the feet; ``blend`` (s) is
+    how long rising into it takes (from a crouch: quicker is a hop)."""
     trans = (Transition("time", next, after),) if next else ()
     return State(name, pose=(("hip", 0.0), ("knee", 0.05), ("ankle", 0.0), ("waist", 0.0),
                              ("neck", 0.0), ("shoulder", 0.0), ("elbow", 0.1), ("wrist", 0.0),
                              ("toe", 0.0)),
-                 support=True, balance=balance, transitions=trans)
+                 support=True, balance=balance, transitions=trans, blend=blend)
 
 
 def crouch(name="crouch", next=None, after=0.6, depth=1.0, lean=0.3) -> State:

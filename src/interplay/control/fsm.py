@@ -15,6 +15,8 @@ Events (``Transition.on``), each with its ``value``:
   ``hand_contact``    a hand touches the environment
   ``com_falling`` / ``com_rising``         the centre of mass's vertical velocity is < 0 / > 0
   ``com_below`` / ``com_above``            the centre of mass's height (m) is below / above value
+  ``com_ahead``       the centre of mass is more than value (m) ahead of the middle of the feet,
+                      along the pelvis's facing direction (a lean far enough to dive)
 Entry actions: ``hold_pose`` (every target becomes the current angle before the state's pose
 applies), ``neutral`` (every target becomes 0, the rest pose).
 """
@@ -27,7 +29,7 @@ import numpy as np
 from ..errors import ParameterError
 
 EVENTS = ("time", "foot_contact", "no_foot_contact", "hand_contact", "com_falling",
-          "com_rising", "com_below", "com_above")
+          "com_rising", "com_below", "com_above", "com_ahead")
 ENTRY_ACTIONS = ("hold_pose", "neutral")
 
 
@@ -172,6 +174,8 @@ class StateMachine:
                 hit = sensors["com_vel"][2] > 0.0
             elif event == "com_below":
                 hit = sensors["com"][2] < value
+            elif event == "com_ahead":
+                hit = sensors["com_ahead"] > value
             else:  # com_above
                 hit = sensors["com"][2] > value
             if hit:

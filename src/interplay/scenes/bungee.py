@@ -1,16 +1,25 @@
 """A man on a bungee cord (SPEC 4): a figure on a bridge platform 40 m up leaps under its state
 machine; a tension-only spring-mass cord tied to both ankles and to the bridge arrests the
 fall; he bounces and comes to hang. Tune the leap with ``--set cord.enabled=false`` (the figure
-alone, fast), then run two-way."""
+alone, fast), then run two-way.
+
+The leap: stand, crouch, tip forward over the toes (ankles dorsiflex with balance off), then a
+timed hip-knee-ankle extension with an arm swing, and a layout (swan dive) in flight. The
+defaults of ``JumperParams`` were found by ``tune_leap`` (simulated annealing over the leap's
+parameters with the cord disabled; ``python -m interplay.scenes.bungee``); docs/figures.md has
+the search and its result. The tuned values are rounded to 0.01; the search's loss is
+sensitive to the exact contact sequence at the edge, so docs/figures.md also lists the
+rounded values' measured leap.
+"""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..control import behaviours as B
-from ..control.fsm import Controller
-from ..geometry.anthropometry import BodyParams
+from ..control.fsm import Controller, State, Transition
+from ..geometry.anthropometry import SEGMENTS, BodyParams
 from ..interactions.attachment import AttachmentParams, SegmentAttachment
 from ..scene import Scene
 from ..systems.figure import Figure, FigureParams
@@ -18,72 +27,189 @@ from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
 
 BRIDGE = 40.0  # m, the platform's top
+EDGE = 0.0  # m, x of the platform's front edge (the jumper faces +x)
+STANCE_X = -0.32  # m, ankle x at rest: the toes end 5 cm short of the edge
+STRAP = 0.25  # m, how far below the ankles the cord's end meets the two ankle straps
+STRAP_STIFFNESS = 2.0e4  # N/m, each strap (webbing: stiff beside the cord)
+TIP_MAX = 1.5  # s: the leap starts by then even if the lean never gets far enough
+STRAIN_LIMIT = 3.0  # a bungee cord is made to stretch: 15 m to ~31 m at the bottom here
 
 
 @dataclass(frozen=True)
 class CordParams:
     """rest length (m), effective stiffness of the whole cord (N/m), mass (kg), points, damping
-    (stiffness-proportional, s); enabled=false leaves the jumper alone (leap tuning)."""
+    (stiffness-proportional, s), dt (s) of its implicit integrator, reach (m): how far past the
+    deck's edge its anchor is (a jump arm, so the cord hangs near plumb when it goes taut);
+    enabled=false leaves the jumper alone (leap tuning).
+
+    Stiffness: k L0 = 3 m g would put the cord's bounce at exactly twice the pendulum
+    frequency, where an elastic pendulum pumps its bounce into a growing swing; 250 N/m keeps
+    the 64 kg jumper well clear of it (k L0 / m g = 5.9). Damping 0.05 s gives the bounce a
+    damping ratio of about 0.05 (k beta / 2 sqrt(k m)), a rubber cord's hysteresis."""
     enabled: bool = True
     length: float = 15.0  # m
-    stiffness: float = 150.0  # N/m, whole cord: k = n k_segment / ... in series
+    stiffness: float = 250.0  # N/m, whole cord: its n-1 springs in series
     mass: float = 1.0  # kg
     points: int = 21
-    damping: float = 0.02  # s
+    damping: float = 0.05  # s
     dt: float = 1e-3  # s
+    reach: float = 1.8  # m
 
 
 @dataclass(frozen=True)
 class JumperParams:
-    """The jumper (the paper's gymnast: 64.38 kg, 1.70 m); lean (rad) of the dive, how long
-    he stands (s) before leaning out."""
+    """The jumper (the paper's gymnast: 64.38 kg, 1.70 m) and his leap: stand (s) before the
+    crouch; crouch (s) and its depth (-, 1 = deep) and trunk lean (rad); then he tips forward
+    over the toes with the ankles driven to tip_ankle (rad of dorsiflexion) until his centre of
+    mass is lead (m) ahead of the middle of his feet; the push:
+    hip (rad of hip flexion it extends to: a forward dive), power (-, scales the extension's
+    velocity targets), arm_swing (rad of shoulder flexion the arms swing to); tuck (s) the knees
+    are pulled up after takeoff so the feet clear the edge, before the layout."""
     mass: float = 64.38  # kg
     height: float = 1.70  # m
-    stand: float = 0.5  # s
-    lean: float = 0.5  # rad
+    stand: float = 0.3  # s
+    crouch: float = 0.7  # s
+    depth: float = 0.59
+    lean: float = 0.45  # rad
+    lead: float = 0.135  # m
+    tip_ankle: float = 0.52  # rad
+    hip: float = 0.60  # rad
+    power: float = 0.69
+    arm_swing: float = 1.61  # rad
+    tuck: float = 0.38  # s
 
 
 @dataclass(frozen=True)
 class BungeeParams:
+    """air_density (kg/m^3): the drag on the jumper's segments (0: none)."""
     jumper: JumperParams = JumperParams()
     cord: CordParams = CordParams()
     tie: AttachmentParams = AttachmentParams()
     coupling_dt: float = 1e-3  # s
+    air_density: float = 1.2  # kg/m^3
 
 
 PARAMS = BungeeParams
 
 
 def controller(p: JumperParams) -> Controller:
-    """Stand, then dive: lean out over the edge (ankles and hips), push off, layout."""
-    return Controller((B.stand(next="leap", after=p.stand),
-                       B.leap(next="layout", power=0.6),
+    """stand -> crouch -> tip -> leap -> tuck (the feet clear the edge) -> layout (the rest
+    of the flight, the bounces and the hang)."""
+    tip = State("tip", pose=(("ankle", p.tip_ankle),), support=True, blend=0.1,
+                transitions=(Transition("com_ahead", "leap", p.lead),
+                             Transition("time", "leap", TIP_MAX)))
+    return Controller((B.stand(next="crouch", after=p.stand),
+                       B.crouch(next="tip", after=p.crouch, depth=p.depth, lean=p.lean),
+                       tip,
+                       B.leap(next="tuck", power=p.power, arm_swing=p.arm_swing, hip=p.hip),
+                       B.tuck(next="layout", after=p.tuck),
                        B.layout()), start="stand")
+
+
+def jumper(p: JumperParams, air_density: float = 1.2) -> Figure:
+    """The jumper on the bridge platform, under his leap controller; air_density (kg/m^3)."""
+    env = EnvironmentParams(floor=None, platform=(-3.0, EDGE, -1.5, 1.5, BRIDGE),
+                            air_density=air_density)
+    return Figure("jumper", FigureParams(body=BodyParams(p.mass, p.height), environment=env,
+                                         position=(STANCE_X, 0.0, BRIDGE)), controller(p))
+
+
+def cord(c: CordParams, anchor, ankles, integrator="implicit", dt=None) -> SpringNetwork:
+    """The cord from ``anchor`` (m, fixed) hanging slack in a V down and back up to a point
+    below the ankles, where two short straps (stiff tension-only springs) lead to the ankles
+    ``ankles`` (2,3) m: points 0..n-1 are the cord, n and n+1 the strap ends; the cord's mass
+    is shared equally by all n+2 points. Settled under gravity with both ends held."""
+    n = c.points
+    anchor, ankles = np.asarray(anchor, float), np.asarray(ankles, float)
+    end = ankles.mean(axis=0) + [0.0, 0.0, -STRAP]
+    s = np.linspace(0.0, 1.0, n)
+    drop = c.length * np.minimum(s, 1.0 - s)  # two legs, each half the rest length long
+    x = np.vstack([anchor + s[:, None] * (end - anchor) - drop[:, None] * [0.0, 0.0, 1.0],
+                   ankles])
+    seg_k = c.stiffness * (n - 1)  # n-1 springs in series give the cord's stiffness
+    strap = np.linalg.norm(ankles - end, axis=1)
+    springs = Springs(np.r_[np.arange(n - 1), n - 1, n - 1], np.r_[np.arange(1, n), n, n + 1],
+                      np.r_[np.full(n - 1, c.length / (n - 1)), strap],
+                      np.r_[np.full(n - 1, seg_k), STRAP_STIFFNESS, STRAP_STIFFNESS],
+                      np.ones(n + 1, dtype=bool))
+    net = SpringNetwork("cord", x, c.mass / (n + 2), springs, dt=dt or c.dt, integrator=integrator,
+                        stiffness_damping=c.damping, fixed=[0, n, n + 1],
+                        strain_limit=STRAIN_LIMIT)
+    net.settle(1.0)
+    net.fixed[[n, n + 1]] = False  # the straps move with the ankles from here on
+    return net
 
 
 def build(coupling: str = "two-way", duration: float = 8.0, fps: float = 30.0,
           integrator: str | None = None, dt: float | None = None,
           params: BungeeParams = BungeeParams()) -> Scene:
-    j, c = params.jumper, params.cord
+    c = params.cord
     scene = Scene("bungee", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
-    env = EnvironmentParams(floor=None, platform=(-3.0, 0.0, -1.5, 1.5, BRIDGE))
-    fig = scene.add(Figure("jumper", FigureParams(body=BodyParams(j.mass, j.height),
-                                                  environment=env, position=(-0.15, 0.0, BRIDGE)),
-                           controller(j)))
+    fig = scene.add(jumper(params.jumper, params.air_density))
     scene.primary = fig
     if c.enabled:
+        feet = ("l_foot", "r_foot")
+        ankles = fig.data.xpos[[fig.seg_body[SEGMENTS.index(f)] for f in feet]]
+        net = scene.add(cord(c, [EDGE + c.reach, 0.0, BRIDGE + 0.5], ankles,
+                             integrator or "implicit", dt))
         n = c.points
-        anchor = np.array([-0.3, 0.0, BRIDGE])
-        ankle = fig.data.xpos[fig.seg_body[11]] * [1, 0, 1]
-        x = anchor + np.linspace(0.0, 1.0, n)[:, None] * (ankle - anchor)
-        seg_k = c.stiffness * (n - 1)  # n-1 springs in series give the cord's stiffness
-        springs = Springs(np.arange(n - 1), np.arange(1, n), np.full(n - 1, c.length / (n - 1)),
-                          np.full(n - 1, seg_k), np.ones(n - 1, dtype=bool))
-        net = scene.add(SpringNetwork("cord", x, c.mass / n, springs,
-                                      dt=dt or c.dt, integrator=integrator or "implicit",
-                                      stiffness_damping=c.damping, fixed=[0]))
-        for side in ("l", "r"):
-            scene.connect(SegmentAttachment(f"cord-{side}-ankle", fig, net, n - 1,
-                                            f"{side}_foot", params=params.tie, mode=coupling))
-    scene.meta = {"bridge_height": BRIDGE}
+        scene.connect(SegmentAttachment("cord", fig, net, ((n, feet[0]), (n + 1, feet[1])),
+                                        params=params.tie, mode=coupling))
+    scene.meta = {"bridge_height": BRIDGE, "platform_edge": EDGE}
     return scene
+
+
+def leap_trial(p: JumperParams, duration: float = 3.0) -> dict:
+    """The figure alone (cord disabled) from stand to dive: takeoff (s, both feet off the
+    deck in the leap), rise (m, highest centre of mass above its standing height), clear_x (m,
+    the centre of mass's distance past the edge when it falls 1 m below the deck; None if it
+    has not by ``duration``), touched (s of deck contact after takeoff), final centre of mass."""
+    fig = jumper(p)
+    z0 = fig.com()[2]
+    out = {"takeoff": None, "rise": 0.0, "clear_x": None, "touched": 0.0}
+    steps = int(round(duration / fig.dt))
+    for _ in range(steps):
+        fig.advance(fig.dt)
+        c = fig.com()
+        out["rise"] = max(out["rise"], c[2] - z0)
+        state = fig.fsm.state.name
+        if out["takeoff"] is None and state == "tuck":
+            out["takeoff"] = fig.time
+        elif out["takeoff"] is not None and fig.data.ncon:
+            out["touched"] += fig.dt
+        if out["clear_x"] is None and c[2] < BRIDGE - 1.0:
+            out["clear_x"] = c[0] - EDGE
+    out["com"] = fig.com()
+    return out
+
+
+def leap_loss(p: JumperParams) -> float:
+    """What the search minimises: minus the clearance past the edge (capped at CLEAR), minus
+    twice the rise (capped at 0.4 m), plus a penalty per second of deck contact after
+    takeoff."""
+    r = leap_trial(p)
+    clear = r["clear_x"] if r["clear_x"] is not None else r["com"][0] - EDGE - 1.0
+    return -min(clear, CLEAR) - 2.0 * min(r["rise"], 0.4) + 50.0 * r["touched"]
+
+
+CLEAR = 0.6  # m past the edge: enough to clear the deck; more only swings him on the cord
+TUNED = ("depth", "lean", "lead", "hip", "power", "arm_swing", "tuck")
+BOUNDS = {"depth": (0.3, 1.1), "lean": (0.0, 0.8), "lead": (0.0, 0.3), "hip": (-0.2, 1.4),
+          "power": (0.5, 2.0), "arm_swing": (1.0, 3.0), "tuck": (0.1, 0.8)}
+
+
+def tune_leap(evaluations: int = 150, seed: int = 0, start: JumperParams = JumperParams()):
+    """Simulated annealing over the leap parameters in TUNED (cord disabled); returns the best
+    JumperParams and the SearchResult."""
+    from ..control.search import anneal
+    res = anneal(lambda d: leap_loss(replace(start, **d)),
+                 {k: getattr(start, k) for k in TUNED}, BOUNDS, evaluations, seed)
+    return replace(start, **res.best), res
+
+
+if __name__ == "__main__":
+    import sys
+    n = int(sys.argv[1]) if len(sys.argv) > 1 else 150
+    best, res = tune_leap(n)
+    print(f"loss {res.loss:.4f} after {n} evaluations; {leap_trial(best)}")
+    print(", ".join(f"{k}={getattr(best, k):.3f}" for k in TUNED))

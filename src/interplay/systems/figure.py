@@ -3,9 +3,11 @@ machine controller, MuJoCo's own ground contact, and forces from other systems t
 ``xfrc_applied``.
 
 Rates: MuJoCo steps at ``dt`` and evaluates the servo law at every step (the servos are MuJoCo
-actuators with exactly the PD law of control/pd.py); the controller (state machine and balance)
-updates targets and gains every ``control_dt``; both are independent of the coupling step, which
-the figure substeps inside one Python loop over ``mj_step``.
+actuators with exactly the PD law of control/pd.py plus the gravity feed-forward of
+control/gravity.py); the controller (state machine and balance) plans targets, gains and the
+feed-forward every ``control_dt``, and the servo reference between its ticks is interpolated
+at every MuJoCo step, so targets move smoothly. Both rates are independent of the coupling
+step, which the figure substeps inside one Python loop over ``mj_step``.
 """
 from __future__ import annotations
 
@@ -14,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..control.gravity import GravityCompensation
 from ..control.fsm import Controller, StateMachine
+from ..control.gravity import GravityCompensation
 from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
 from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, joint_names, segment_mesh
@@ -35,8 +37,9 @@ class FigureParams:
     below the pelvis at rest; yaw (rad): heading about +z (0 faces +x); dt (s): MuJoCo's step;
     control_dt (s): the controller's period; omega (rad/s) and zeta (-): default servo natural
     frequency and damping ratio; support_omega (rad/s): the stance legs' frequency while they
-    carry the body (about the whole body's inertia, so soft, with tau_g holding the weight); gravity_compensation: add the feed-forward torques that hold the
-    desired pose against gravity (control/gravity.py) to the servo law."""
+    carry the body (about the whole body's inertia, so soft, with tau_g holding the weight);
+    gravity_compensation: add the feed-forward torques that hold the desired pose against
+    gravity (control/gravity.py) to the servo law."""
     body: BodyParams = BodyParams()
     environment: EnvironmentParams = EnvironmentParams()
     position: tuple = (0.0, 0.0, 0.0)  # m
@@ -213,14 +216,23 @@ class Figure(System):
         self.apply_gains()
 
     def sensors(self) -> dict:
-        """What transitions read: foot/hand contact, centre of mass (m) and its velocity (m/s)."""
+        """What transitions read: foot/hand contact, centre of mass (m), its velocity (m/s) and
+        how far (m) it is ahead of the middle of the feet along the facing direction."""
         d, m = self.data, self.model
         geoms = d.contact.geom[:d.ncon]
         self._mj.mj_subtreeVel(m, d)
+        com = d.subtree_com[self.root].copy()
         return {"foot_contact": bool(np.isin(geoms, self.foot_geoms).any()),
                 "hand_contact": bool(np.isin(geoms, self.hand_geoms).any()),
-                "com": d.subtree_com[self.root].copy(),
-                "com_vel": d.subtree_linvel[self.root].copy()}
+                "com": com, "com_vel": d.subtree_linvel[self.root].copy(),
+                "com_ahead": float(np.dot(com - d.geom_xpos[self.sole_geoms].mean(axis=0),
+                                          self._forward()))}
+
+    def _forward(self) -> np.ndarray:
+        """The pelvis's facing direction in the horizontal plane (unit)."""
+        fwd = self.data.xmat[self.root].reshape(3, 3)[:, 0].copy()
+        fwd[2] = 0.0
+        return fwd / max(np.linalg.norm(fwd), 1e-9)
 
     def _control(self, t):
         if self.fsm is not None:
@@ -246,9 +258,7 @@ class Figure(System):
         if len(touching) == 0:
             return self.balance_offset
         centre = d.geom_xpos[touching].mean(axis=0)
-        fwd = d.xmat[self.root].reshape(3, 3)[:, 0].copy()
-        fwd[2] = 0.0
-        fwd /= max(np.linalg.norm(fwd), 1e-9)
+        fwd = self._forward()
         kp, kd = self.fsm.state.balance
         e = float(np.dot(s["com"] - centre, fwd))
         v = float(np.dot(s["com_vel"], fwd))
@@ -285,12 +295,22 @@ class Figure(System):
             ctrl += c0
             mj.mj_step(m, d)
 
+    def _sync(self):
+        """Positions, frames and velocities of the segments for the state mj_step ended in
+        (mj_step leaves them from the start of its step): what interactions read."""
+        m, d, mj = self.model, self.data, self._mj
+        mj.mj_kinematics(m, d)
+        mj.mj_comPos(m, d)
+        mj.mj_comVel(m, d)
+
     def step(self, h):
         self._run(1, h)
+        self._sync()
 
     def advance(self, h):
         n = max(1, math.ceil(h / self.dt - 1e-9))
         self._run(n, h / n)
+        self._sync()
         self.time += h
 
     # --- measures ----------------------------------------------------------------------------
@@ -308,12 +328,7 @@ class Figure(System):
         return 0.5 * float(np.dot(self.data.qvel, res))
 
     def momentum(self):
-        # recompute the centre-of-mass velocities for the current state (mj_step leaves them
-        # from the start of the last step)
         m, d = self.model, self.data
-        self._mj.mj_kinematics(m, d)
-        self._mj.mj_comPos(m, d)
-        self._mj.mj_comVel(m, d)
         self._mj.mj_subtreeVel(m, d)
         return self._mass * self.data.subtree_linvel[self.root].copy()
 

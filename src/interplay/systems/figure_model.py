@@ -25,10 +25,12 @@ FIGURE_GROUP, WORLD_GROUP = 2, 1  # contype/conaffinity bits: figure-world only,
 class EnvironmentParams:
     """What the figure stands on. floor: height (m) of a ground plane, None for none; platform:
     (x_min, x_max, y_min, y_max, top) m of a static deck whose top face is at z = top, () for
-    none; friction: Coulomb coefficient of the feet on them (-)."""
+    none; friction: Coulomb coefficient of the feet on them (-); air_density (kg/m^3): 0 for
+    none, else MuJoCo's quadratic drag on each segment's equivalent inertia box (air: 1.2)."""
     floor: float | None = 0.0  # m
     platform: tuple = ()  # m
     friction: float = 1.0
+    air_density: float = 0.0  # kg/m^3
 
 
 def joint_group(name: str) -> str:
@@ -47,6 +49,7 @@ def build_model(plan: list[Segment], env: EnvironmentParams, dt: float, root=(0.
     spec.option.timestep = dt
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = [0.0, 0.0, -9.81 if gravity else 0.0]
+    spec.option.density = float(env.air_density)
     world = spec.worldbody
     wkw = dict(contype=WORLD_GROUP, conaffinity=FIGURE_GROUP, friction=[env.friction, 0.005, 1e-4])
     if env.floor is not None:
