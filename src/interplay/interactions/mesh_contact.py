@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
 from ..geometry.bvh import BVH, check_points, check_thickness
+from ..kernels.bvh import deepest_on_segments
 from ..kernels.rigid import quat_to_matrix
 from ..kernels.trimesh_contact import respond, signed_triangle_distance
 from ..systems.colliders import StaticShape
@@ -97,11 +98,16 @@ class _Side:
         if self.rigid:
             v, t = surface if surface is not None else system.surface()
             self.tree = BVH(v, t, owner=system.name)
+            self._reach = np.sqrt((self.tree.body_x ** 2).sum(axis=1).max())  # m, from centre
             self.signed = True
         elif self.net:
             tris = surface[1] if surface is not None else getattr(system, "triangles", None)
             if tris is not None:
                 self.tree = BVH(system.x, tris, owner=system.name, pad=p.thickness + p.skin)
+            else:
+                # a net of cords: its springs collide as segments (with closed surfaces)
+                self.segs = BVH(system.x, system.segments(), owner=system.name,
+                                pad=p.thickness + p.skin)
             self.signed = False
         else:
             raise ParameterError(f"{owner}: {system.name} ({type(system).__name__}) cannot "
@@ -118,8 +124,7 @@ class _Side:
             self.R = quat_to_matrix(s.q)
             # the end pose of the step: translation predicted, rotation bounded by a pad
             self.tree.transform(self.R, s.x, self.R, s.x + s.v * h)
-            reach = np.sqrt((self.tree.body_x ** 2).sum(axis=1).max())
-            pad = np.linalg.norm(s.w) * h * reach + self._pad
+            pad = np.linalg.norm(s.w) * h * self._reach + self._pad
             self.tree.lo -= pad
             self.tree.hi += pad
             self.x = check_points(s.name, self.tree.x)
@@ -134,6 +139,20 @@ class _Side:
             self.winv = np.where(s.fixed, 0.0, 1.0 / s.m)
             if self.tree is not None:
                 self.tree.refit(self.x, self.x + self.v * h)
+            else:
+                self.segs.refit(self.x, self.x + self.v * h)
+
+    def bounds(self, h):
+        """A cheap world box (lo, hi) m holding the side's surface over the next h s, for
+        skipping the exchange while the two sides are apart; None for static sides."""
+        s = self.sys
+        if self.static:
+            return None
+        if self.rigid:
+            r = self._reach + self._pad + np.linalg.norm(s.v) * h
+            return s.x - r, s.x + r
+        grow = self._pad + np.abs(s.v).max() * h
+        return s.x.min(axis=0) - grow, s.x.max(axis=0) + grow
 
     def point_inverse_mass(self, r, n):
         """Inverse effective mass (1/kg) of a rigid body along n at offsets r from its centre."""
@@ -166,13 +185,39 @@ class MeshContact(Interaction):
         self._h = h
 
     # --- detection ---------------------------------------------------------------------------
+    def _queries(self, P: _Side, Q: _Side):
+        """P's query points against Q: (positions (k,3), vertex indices (k,w), weights (k,w)).
+        A rigid body's mesh vertices and a cloth's particles are points (w = 1); a net of
+        cords against a closed surface gives each cord's deepest point (w = 2, the cord's
+        ends), one contact per cord."""
+        if P.net and P.tree is None:
+            if Q.static or Q.net:
+                n = len(P.x)
+                return P.x, np.arange(n)[:, None], np.ones((n, 1))
+            pairs = P.segs.overlapping(Q.tree)  # (segment, triangle)
+            segs = P.segs.elements
+            order = np.argsort(pairs[:, 0], kind="stable")
+            start = np.searchsorted(pairs[order, 0], np.arange(len(segs) + 1))
+            t, s = np.empty(len(segs)), np.empty(len(segs))
+            deepest_on_segments(Q.x, Q.tree.elements, start, np.ascontiguousarray(
+                pairs[order, 1]), P.x, segs, t, s)
+            on = np.flatnonzero(s < self.p.thickness + self.p.skin)
+            t = t[on]
+            w = np.stack([1.0 - t, t], axis=1)
+            vid = segs[on]
+            return np.einsum("kj,kjd->kd", w, P.x[vid]), vid, w
+        n = len(P.x)
+        return P.x, np.arange(n)[:, None], np.ones((n, 1))
+
     def _contacts(self, P: _Side, Q: _Side):
-        """Contacts of P's points with Q's surface: (point indices, s, normals towards P, Q's
-        triangle vertex indices (k,3) and weights (k,3) or None)."""
+        """Contacts of P's query points with Q's surface: (P's vertex indices (k,w) and weights,
+        positions, s, normals towards P, Q's triangle vertex indices (k,3) and weights (k,3),
+        or None for a static Q)."""
         p = self.p
         if P.static or (Q.net and Q.tree is None):
             return None
-        x = P.x
+        x, pv, pw = self._queries(P, Q)
+        band = p.thickness + p.skin
         if Q.static:
             if Q.shape is None:  # the floor plane z = height
                 s = x[:, 2] - Q.sys.height
@@ -180,98 +225,93 @@ class MeshContact(Interaction):
                 n[:, 2] = 1.0
             else:
                 s, n = Q.shape.distance(x)
-            idx = np.flatnonzero((s < p.thickness + p.skin) & (s > -p.depth))
-            return idx, s[idx], n[idx], None, None
-        reach = max(p.thickness + p.skin, p.depth) if Q.signed else p.thickness + p.skin
+            idx = np.flatnonzero((s < band) & (s > -p.depth))
+            return pv[idx], pw[idx], x[idx], s[idx], n[idx], None, None
+        reach = max(band, p.depth) if Q.signed else band
         tri, d, bary = Q.tree.nearest(x, reach, skip_incident=P is Q)
         idx = np.flatnonzero(tri >= 0)
         s, n = np.empty(len(idx)), np.empty((len(idx), 3))
         signed_triangle_distance(x[idx], tri[idx], bary[idx], d[idx], Q.x, Q.tree.elements,
                                  Q.signed, s, n)
-        keep = s < p.thickness + p.skin
+        keep = s < band
         idx, s, n = idx[keep], s[keep], n[keep]
-        return idx, s, n, Q.tree.elements[tri[idx]], bary[idx]
+        return pv[idx], pw[idx], x[idx], s, n, Q.tree.elements[tri[idx]], bary[idx]
 
     # --- response ----------------------------------------------------------------------------
+    @staticmethod
+    def _gather(side: _Side, vid, w, xp, n):
+        """Velocity, acceleration and inverse effective mass along n of a side at contact
+        points xp: a rigid body's material point there, or a weighted set of network points."""
+        k = len(xp)
+        if side.static:
+            return np.zeros((k, 3)), np.zeros((k, 3)), np.zeros(k)
+        if side.rigid:
+            r = xp - side.sys.x
+            return (side.sys.v + np.cross(side.sys.w, r), np.broadcast_to(side.a[0], (k, 3)),
+                    side.point_inverse_mass(r, n))
+        return (np.einsum("kj,kjd->kd", w, side.v[vid]), np.einsum("kj,kjd->kd", w, side.a[vid]),
+                np.einsum("kj,kj->k", w ** 2, side.winv[vid]))
+
     def _forces(self, P: _Side, Q: _Side, found, key):
-        """Forces on P's points and their reactions on Q; returns per-side force records.
-        key names the direction (which side's points) for the friction springs' stretch."""
-        idx, s, n, qv, qw = found
-        p, k = self.p, len(idx)
-        xp = P.x[idx]
-        vP, aP = P.v[idx], P.a[idx]
-        wP = P.point_inverse_mass(xp - P.sys.x, n) if P.rigid else P.winv[idx]
-        if Q.static:
-            vQ, aQ, wQ = np.zeros((k, 3)), np.zeros((k, 3)), np.zeros(k)
-        elif Q.rigid:
-            r = xp - Q.sys.x
-            vQ = Q.sys.v + np.cross(Q.sys.w, r)
-            aQ = np.broadcast_to(Q.a[0], (k, 3))
-            wQ = Q.point_inverse_mass(r, n)
-        else:
-            vQ = np.einsum("kj,kjd->kd", qw, Q.v[qv])
-            aQ = np.einsum("kj,kjd->kd", qw, Q.a[qv])
-            wQ = np.einsum("kj,kj->k", qw ** 2, Q.winv[qv])
+        """Forces at the contacts, on P (and the reactions on Q). key names the direction, for
+        the friction springs' stretch, kept per P vertex (its first weighted vertex)."""
+        pv, pw, xp, s, n, qv, qw = found
+        p = self.p
+        vP, aP, wP = self._gather(P, pv, pw, xp, n)
+        vQ, aQ, wQ = self._gather(Q, qv, qw, xp, n)
         inv_m = wP + wQ
-        ok = inv_m > 0.0
+        sel = np.flatnonzero(inv_m > 0.0)  # two pinned points cannot push each other
         steps = p.contact_steps or (10.0 if (P.rigid or Q.rigid) else 3.0)
         omega = 1.0 / (steps * self._h)
-        sel = np.flatnonzero(ok)
-        if len(sel):
-            fo, jxo, jvo = np.empty((len(sel), 3)), np.empty((len(sel), 3, 3)), np.empty(
-                (len(sel), 3, 3))
-            old = self._stretch.get(key)
-            stretch = np.zeros((len(sel), 3))
-            if old is not None and len(old) == len(P.x):
-                stretch[:] = old[idx[sel]]
-            act = respond(np.ascontiguousarray(n[sel]), p.thickness - s[sel],
-                          np.ascontiguousarray((vP - vQ)[sel]),
-                          np.ascontiguousarray((aP - aQ)[sel]), inv_m[sel],
-                          -1.0 if p.stiffness is None else p.stiffness,
-                          -1.0 if p.damping is None else p.damping, omega, p.friction, p.eps,
-                          self._h, p.constraint, stretch, fo, jxo, jvo)
-            kept = np.zeros((len(P.x), 3))  # contacts that ended forget their stretch
-            kept[idx[sel[act]]] = stretch[act]
-            self._stretch[key] = kept
-            sel = sel[act]
-            f, jx, jv = fo[act], jxo[act], jvo[act]
-        else:
-            self._stretch.pop(key, None)
-            f, jx, jv = np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros((0, 3, 3))
-        rec_p = (idx[sel], xp[sel], f, jx, jv, vQ[sel])
-        if Q.static:
-            return rec_p, None
-        w = None if qw is None else qw[sel]
-        rec_q = (None if qv is None else qv[sel], xp[sel], -f, jx, jv, vP[sel], w)
+        f, jx, jv = np.empty((len(sel), 3)), np.empty((len(sel), 3, 3)), np.empty(
+            (len(sel), 3, 3))
+        keyv = pv[sel, 0] if pv.shape[1] == 1 else pv[sel, 0] * len(P.x) + pv[sel, 1]
+        old_keys, old = self._stretch.get(key, (np.zeros(0, np.int64), np.zeros((0, 3))))
+        stretch = np.zeros((len(sel), 3))
+        if len(old_keys):
+            pos = np.searchsorted(old_keys, keyv).clip(0, len(old_keys) - 1)
+            hit = old_keys[pos] == keyv
+            stretch[hit] = old[pos[hit]]
+        act = respond(np.ascontiguousarray(n[sel]), p.thickness - s[sel],
+                      np.ascontiguousarray((vP - vQ)[sel]), np.ascontiguousarray((aP - aQ)[sel]),
+                      inv_m[sel], -1.0 if p.stiffness is None else p.stiffness,
+                      -1.0 if p.damping is None else p.damping, omega, p.friction, p.eps,
+                      self._h, p.constraint, stretch, f, jx, jv)
+        order = np.argsort(keyv[act])
+        self._stretch[key] = (keyv[act][order], stretch[act][order])
+        sel = sel[act]
+        f, jx, jv = f[act], jx[act], jv[act]
+        rec_p = (pv[sel], pw[sel], xp[sel], f, jx, jv, vQ[sel])
+        rec_q = None if Q.static else (None if qv is None else qv[sel],
+                                       None if qw is None else qw[sel], xp[sel], -f, jx, jv,
+                                       vP[sel])
         return rec_p, rec_q
 
     @staticmethod
-    def _apply_points(side: _Side, rec):
-        """Apply P-side records (one force per point) to a side."""
-        idx, xp, f, jx, jv, vref = rec
-        if side.rigid:
-            side.sys.add_wrench(f.sum(axis=0), np.cross(xp - side.sys.x, f).sum(axis=0),
-                                dfdx=jx.sum(axis=0), dfdv=jv.sum(axis=0))
-        else:
-            side.sys.add_point_forces(idx, f, jx, jv, vref)
-
-    @staticmethod
-    def _apply_surface(side: _Side, rec):
-        """Apply Q-side reactions: at the contact point of a rigid body, or by barycentric
-        weights on a network's triangle (force w F, Jacobian w^2 J)."""
-        tv, xp, f, jx, jv, vref, w = rec
+    def _apply(side: _Side, rec):
+        """Apply forces at contact points: a force and torque on a rigid body, or split over
+        network points by their weights (force w F, Jacobian w^2 J: equal and opposite to the
+        other side's in sum)."""
+        vid, w, xp, f, jx, jv, vref = rec
         if side.rigid:
             side.sys.add_wrench(f.sum(axis=0), np.cross(xp - side.sys.x, f).sum(axis=0),
                                 dfdx=jx.sum(axis=0), dfdv=jv.sum(axis=0))
             return
-        k = len(f)
-        side.sys.add_point_forces(tv.reshape(-1), (w[:, :, None] * f[:, None, :]).reshape(-1, 3),
-                                  ((w ** 2)[:, :, None, None] * jx[:, None]).reshape(-1, 3, 3),
-                                  ((w ** 2)[:, :, None, None] * jv[:, None]).reshape(-1, 3, 3),
-                                  np.repeat(vref, 3, axis=0).reshape(k * 3, 3))
+        k, m = vid.shape
+        w2 = (w ** 2)[:, :, None, None]
+        side.sys.add_point_forces(vid.reshape(-1), (w[:, :, None] * f[:, None, :]).reshape(-1, 3),
+                                  (w2 * jx[:, None]).reshape(-1, 3, 3),
+                                  (w2 * jv[:, None]).reshape(-1, 3, 3),
+                                  np.repeat(vref, m, axis=0))
 
     def exchange(self, to_primary, to_secondary):
         A, B = self.a, self.b
+        ba, bb = A.bounds(self._h), B.bounds(self._h)
+        if ba is not None and bb is not None and (np.any(ba[0] > bb[1] + self.p.depth)
+                                                  or np.any(bb[0] > ba[1] + self.p.depth)):
+            self._stretch.clear()
+            self.n_contacts = 0
+            return np.zeros(3), np.zeros(3), False
         A.update(self._h)
         B.update(self._h)
         total = np.zeros(3)
@@ -289,15 +329,49 @@ class MeshContact(Interaction):
             count += len(rec_p[0])
             on_primary = rec_p if p_is_primary else rec_q
             if on_primary is not None:
-                xp, f = on_primary[1], on_primary[2]
+                xp, f = on_primary[2], on_primary[3]
                 total += f.sum(axis=0)
                 if A.rigid:
                     torque += np.cross(xp - A.sys.x, f).sum(axis=0)
-            for side, rec, is_p in ((P, rec_p, True), (Q, rec_q, False)):
+            for side, rec in ((P, rec_p), (Q, rec_q)):
                 if rec is None or side.static:
                     continue
                 if (side is A and not to_primary) or (side is B and not to_secondary):
                     continue
-                (self._apply_points if is_p else self._apply_surface)(side, rec)
+                self._apply(side, rec)
         self.n_contacts = count
         return total, torque, count > 0
+
+
+class SelfContact(MeshContact):
+    """A cloth against itself: each particle against the network's own triangles, skipping the
+    triangles it belongs to (SPEC 2.5 self-collision). The forces are internal: they sum to
+    zero and the logged force on the "primary" (the same network) is their sum, zero."""
+
+    def __init__(self, name, network, params: MeshContactParams = MeshContactParams()):
+        Interaction.__init__(self, name, network, network, "two-way")
+        self.p = params.validated(name)
+        if getattr(network, "triangles", None) is None:
+            raise ParameterError(f"{name}: self-collision needs a network with triangles; "
+                                 f"{network.name} has none (build it with "
+                                 "SpringNetwork.from_mesh)")
+        self.a = self.b = _Side(network, None, self.p, name)
+        self.a._pad = self.p.thickness + self.p.skin
+        self._h = 0.0
+        self.n_contacts = 0
+        self._stretch = {}
+
+    def exchange(self, to_primary, to_secondary):
+        S = self.a
+        S.update(self._h)
+        found = self._contacts(S, S)
+        self.n_contacts = 0
+        if len(found[0]) == 0:
+            self._stretch.clear()
+            return np.zeros(3), np.zeros(3), False
+        rec_p, rec_q = self._forces(S, S, found, True)
+        self.n_contacts = len(rec_p[0])
+        if self.n_contacts and (to_primary or to_secondary):
+            self._apply(S, rec_p)
+            self._apply(S, rec_q)
+        return np.zeros(3), np.zeros(3), self.n_contacts > 0
