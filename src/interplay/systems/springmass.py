@@ -3,21 +3,25 @@
 Point masses joined by linear springs, with Rayleigh damping (mass-proportional -alpha m v and
 stiffness-proportional along each spring, kd = beta k), optional tension-only cords, points
 fixed in place (constraint filter) and points tied to world positions by anchor springs.
-Two integrators: ``explicit`` (symplectic Euler, the reference) and ``implicit`` (backward
-Euler, one Newton step, preconditioned CG; Baraff & Witkin 1998).
+Three integrators: ``explicit`` (symplectic Euler, the reference), ``implicit`` (backward
+Euler, one Newton step, preconditioned CG; Baraff & Witkin 1998) and ``localglobal`` (Liu et
+al. 2013: a prefactored constant matrix and per-spring projections; ``kernels/localglobal.py``).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
+from ..kernels import localglobal as LG
+from ..kernels import parallel as PAR
 from ..kernels import springs as K
 from ..kernels.subcycle import substep_with_spheres
 from .base import GRAVITY, System
 
-INTEGRATORS = ("explicit", "implicit")
+INTEGRATORS = ("explicit", "implicit", "localglobal")
 SCHEMES = ("bdf2", "theta")
 
 
@@ -61,7 +65,12 @@ class SpringNetwork(System):
     fixed: indices of points that never move; strain_limit: a strain above which the state is
     reported unstable; scheme: the implicit integrator, "bdf2" (second order, little numerical
     damping of resolved motion) or "theta" (theta-method: theta = 1 backward Euler, 1/2
-    trapezoidal).
+    trapezoidal); lg_iterations: local/global iterations per step (integrator="localglobal":
+    more iterations converge towards backward Euler, fewer are cheaper and softer); lg_rho: the
+    Chebyshev acceleration's convergence-rate estimate (0 = plain iterations; above ~0.97 the
+    iteration can diverge); parallel:
+    explicit spring forces on all threads (per spring, then a per-point gather: equal to the
+    serial kernel to round-off); None uses them from ``kernels.parallel.PARALLEL_MIN_SPRINGS``.
     """
 
     kind = "springmass"
@@ -69,7 +78,7 @@ class SpringNetwork(System):
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
-                 scheme="theta", theta=1.0):
+                 scheme="theta", theta=1.0, lg_iterations=10, lg_rho=0.95, parallel=None):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -127,6 +136,14 @@ class SpringNetwork(System):
         self._seg = None
         self.impulses = np.zeros((0, 7))
         self.cg_iterations = 0
+        self.lg_iterations = int(require_positive(name, "lg_iterations", lg_iterations))
+        self.lg_rho = float(lg_rho)
+        self._lg = None  # the factored local/global matrix and what it was built from
+        self.lg_factorizations = 0
+        if parallel is None:
+            parallel = len(self.si) >= PAR.PARALLEL_MIN_SPRINGS and numba.get_num_threads() > 1
+        # point -> spring adjacency (CSR) for the parallel explicit kernel
+        self._adj = (PAR.adjacency(len(x), self.si, self.sj, self.a_idx) if parallel else None)
         self.check_step(self.dt)
 
     @classmethod
@@ -240,10 +257,15 @@ class SpringNetwork(System):
         self._spheres.append((centre, velocity, spin, accel, radius, mass, contact))
         return len(self._spheres) - 1
 
-    def _advance_with_spheres(self, h, n):
+    def _sphere_arrays(self):
         sp = self._spheres
-        arr = [np.array([s[i] for s in sp], dtype=float) for i in range(7)]
+        arr = [np.array([s[i] for s in sp], dtype=float).reshape(len(sp), *shape)
+               for i, shape in enumerate(((3,), (3,), (3,), (3,), (), (), (6,)))]
         self.impulses = np.zeros((len(sp), 7))
+        return arr
+
+    def _advance_with_spheres(self, h, n):
+        arr = self._sphere_arrays()
         substep_with_spheres(
             self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
             self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha,
@@ -261,11 +283,44 @@ class SpringNetwork(System):
                          self.alpha, self.gravity, self.fext, self._f)
         return self._f
 
-    def step(self, h):
-        if self.integrator == "explicit":
+    def _factors(self, h):
+        """The local/global factorization for step h, rebuilt only when the step, the masses,
+        the damping, the springs, the anchors or the fixed set changed."""
+        arrays = (self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k)
+        lg = self._lg
+        if (lg is None or lg[0] != (h, self.alpha, self.beta)
+                or not all(np.array_equal(a, b) for a, b in zip(arrays, lg[1]))):
+            fac = LG.factor(self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k,
+                            self.alpha, self.beta, h)
+            self._lg = lg = ((h, self.alpha, self.beta), tuple(a.copy() for a in arrays), fac)
+            self.lg_factorizations += 1
+        return lg[2]
+
+    def _localglobal(self, h, n):
+        """n local/global steps of h/n with the held forces and any moving spheres."""
+        arr = self._sphere_arrays()
+        fid, *lu = self._factors(h / n)
+        LG.localglobal_steps(self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k,
+                             self.tension_only, self.a_idx, self.a_pos, self.a_k, self.alpha,
+                             self.beta, self.gravity, self.fext, h / n, n, self.lg_iterations, self.lg_rho,
+                             *lu, arr[0], arr[1], arr[3], arr[4], arr[6], self.impulses)
+
+    def _explicit(self, h, n):
+        """n symplectic-Euler steps of h s with the held forces, serial or parallel."""
+        if self._adj is None:
             K.explicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k,
                             self.kd, self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
-                            self.alpha, self.gravity, self.fext, self._f, h, 1)
+                            self.alpha, self.gravity, self.fext, self._f, h, n)
+        else:
+            PAR.explicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0,
+                              self.k, self.kd, self.tension_only, self.a_pos, self.a_k, self.a_c,
+                              self.alpha, self.gravity, self.fext, self._f, h, n, self._adj)
+
+    def step(self, h):
+        if self.integrator == "localglobal":
+            self._localglobal(h, 1)
+        elif self.integrator == "explicit":
+            self._explicit(h, 1)
         else:
             self.cg_iterations = K.implicit_step(
                 self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
@@ -278,12 +333,13 @@ class SpringNetwork(System):
     def advance(self, h):
         # Explicit substeps with held forces run inside one kernel call (no Python per substep).
         n = max(1, int(np.ceil(h / self.dt - 1e-9)))
-        if self._spheres:
+        if self.integrator == "localglobal":
+            self._localglobal(h, n)
+            self.time += h
+        elif self._spheres:
             self._advance_with_spheres(h, n)
         elif self.integrator == "explicit" and n > 1:
-            K.explicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k,
-                            self.kd, self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
-                            self.alpha, self.gravity, self.fext, self._f, h / n, n)
+            self._explicit(h / n, n)
             self.time += h
         else:
             super().advance(h)

@@ -1,0 +1,97 @@
+"""Race-free parallel spring forces for large networks.
+
+Scattering each spring's force onto its two points from several threads would race on shared
+points. Instead the forces are computed per spring in parallel into their own rows, then every
+point gathers the forces of its incident springs over a CSR adjacency (point -> springs, with
+the sign of its end), again in parallel and without shared writes. The per-spring arithmetic is
+the serial kernel's (``springs.network_forces``); only the order of the sums differs, so results
+agree to round-off. Below ``PARALLEL_MIN_SPRINGS`` springs the thread start-up and the extra
+pass over the per-spring buffer cost more than they save, and the serial kernel is used.
+"""
+import numpy as np
+from numba import njit, prange
+
+# On an idle 2-core machine a 59k-spring cloth step ran 1.9x faster on 2 threads (DESIGN.md).
+# With the other core busy (2026-11-22, `bench_cloth.py --threshold`) the parallel step was
+# 0.5-0.9x the serial one at every size from 5k to 325k springs: on a loaded machine pass
+# SpringNetwork(parallel=False).
+PARALLEL_MIN_SPRINGS = 50000
+
+
+def adjacency(n, si, sj, a_idx):
+    """(indptr, spring ids, sign, anchor indptr, anchor ids, scratch): the CSR of point ->
+    incident springs (sign +1 at si, -1 at sj), of point -> anchors, and an (s,3) buffer."""
+    def csr(ends, ids):
+        order = np.argsort(ends, kind="stable")
+        indptr = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(ends, minlength=n), out=indptr[1:])
+        return indptr, ids[order].astype(np.int64), order
+    s = np.arange(len(si))
+    indptr, ids, order = csr(np.concatenate([si, sj]), np.concatenate([s, s]))
+    sign = np.concatenate([np.ones(len(si)), -np.ones(len(sj))])[order]
+    a_ptr, a_ids, _ = csr(np.asarray(a_idx, dtype=np.int64), np.arange(len(a_idx)))
+    return indptr, ids, sign, a_ptr, a_ids, np.empty((len(si), 3))
+
+
+@njit(cache=True, inline="always")
+def _spring_force(s, x, v, si, sj, l0, k, kd, tension_only, fs):
+    """fs[s] (N): the force of spring s on its point si[s] (minus it on sj[s])."""
+    a = si[s]
+    b = sj[s]
+    d0 = x[a, 0] - x[b, 0]
+    d1 = x[a, 1] - x[b, 1]
+    d2 = x[a, 2] - x[b, 2]
+    l2 = d0 * d0 + d1 * d1 + d2 * d2
+    if l2 <= 0.0 or (tension_only[s] and l2 < l0[s] * l0[s]):
+        fs[s, 0] = 0.0
+        fs[s, 1] = 0.0
+        fs[s, 2] = 0.0
+        return
+    inv = 1.0 / np.sqrt(l2)
+    vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1 + (v[a, 2] - v[b, 2]) * d2) * inv
+    mag = (-k[s] * (l2 * inv - l0[s]) - kd[s] * vr) * inv
+    fs[s, 0] = mag * d0
+    fs[s, 1] = mag * d1
+    fs[s, 2] = mag * d2
+
+
+@njit(cache=True, inline="always")
+def _gather_point(p, x, v, m, alpha, gravity, fext, indptr, ids, sign, fs, a_ptr, a_ids, a_pos,
+                  a_k, a_c, f):
+    """f[p]: external, gravity, mass damping, the incident springs' forces and p's anchors."""
+    f0 = fext[p, 0] + m[p] * (gravity[0] - alpha * v[p, 0])
+    f1 = fext[p, 1] + m[p] * (gravity[1] - alpha * v[p, 1])
+    f2 = fext[p, 2] + m[p] * (gravity[2] - alpha * v[p, 2])
+    for e in range(indptr[p], indptr[p + 1]):
+        s = ids[e]
+        g = sign[e]
+        f0 += g * fs[s, 0]
+        f1 += g * fs[s, 1]
+        f2 += g * fs[s, 2]
+    for e in range(a_ptr[p], a_ptr[p + 1]):
+        r = a_ids[e]
+        f0 += -a_k[r] * (x[p, 0] - a_pos[r, 0]) - a_c[r] * v[p, 0]
+        f1 += -a_k[r] * (x[p, 1] - a_pos[r, 1]) - a_c[r] * v[p, 1]
+        f2 += -a_k[r] * (x[p, 2] - a_pos[r, 2]) - a_c[r] * v[p, 2]
+    f[p, 0] = f0
+    f[p, 1] = f1
+    f[p, 2] = f2
+
+
+@njit(cache=True, parallel=True, fastmath=True)
+def explicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_pos, a_k, a_c, alpha,
+                  gravity, fext, f, h, nsteps, adj):
+    """``springs.explicit_step`` (nsteps symplectic-Euler steps of h s) with parallel forces:
+    two parallel loops a step, per spring then per point (gather and update fused)."""
+    indptr, ids, sign, a_ptr, a_ids, fs = adj
+    for _ in range(nsteps):
+        for s in prange(si.shape[0]):
+            _spring_force(s, x, v, si, sj, l0, k, kd, tension_only, fs)
+        for p in prange(x.shape[0]):
+            _gather_point(p, x, v, m, alpha, gravity, fext, indptr, ids, sign, fs, a_ptr,
+                          a_ids, a_pos, a_k, a_c, f)
+            if fixed[p]:
+                continue
+            for c in range(3):
+                v[p, c] += h * f[p, c] / m[p]
+                x[p, c] += h * v[p, c]
