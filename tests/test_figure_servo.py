@@ -98,7 +98,7 @@ def test_servo_reference_moves_at_every_step():
     ctrl = []
     for _ in range(400):
         f.advance(1e-3)
-        ctrl.append(f.data.ctrl.copy())
+        ctrl.append(f.data.act.copy())
     step = np.abs(np.diff(np.array(ctrl)[150:350], axis=0)).max(axis=1)
     # inside the blend the reference changes at every 1 ms step, not once per 5 ms tick
     assert np.all(step > 0.0)

@@ -43,9 +43,11 @@ class GravityCompensation:
         self.qadr, self.vadr = qadr, vadr
         self.foot_bodies, self.sole_geoms = foot_bodies, sole_geoms
         self.free = free
-        self.weight = -float(model.body_mass.sum()) * model.opt.gravity
+        self.weight = -float(model.body_mass.sum()) * float(model.opt.gravity[2])  # N, up
         self._bias = np.zeros(model.nv)
         self._jac = np.zeros((3, model.nv))
+        self._point = np.zeros(3)
+        self._none = np.zeros(len(qadr))
         self.root_residual = np.zeros(6 if free else 0)  # generalized force left on the root
 
     def torques(self, qpos, targets, feet) -> np.ndarray:
@@ -53,22 +55,23 @@ class GravityCompensation:
         in ``qpos``; feet: indices into foot_bodies of the feet on the ground (empty: flight
         for a free figure)."""
         if self.free and len(feet) == 0:
-            return np.zeros(len(self.qadr))
+            return self._none.copy()
         m, d, mj = self.model, self.data, self._mj
         d.qpos[:] = qpos
         d.qpos[self.qadr] = targets
         mj.mj_kinematics(m, d)
         mj.mj_comPos(m, d)
         mj.mj_rne(m, d, 0, self._bias)  # qvel = 0 in this scratch data: gravity only
-        tau = self._bias.copy()
+        tau = self._bias
         if self.free:
             com = d.subtree_com[1]
             pos = d.geom_xpos[self.sole_geoms[feet]]
-            mean = pos.mean(axis=0)
+            shift = com[:2] - pos[:, :2].mean(axis=0)
             share = self.weight / len(feet)
             for f, p in zip(feet, pos):
-                point = np.array([com[0] + p[0] - mean[0], com[1] + p[1] - mean[1], p[2]])
-                mj.mj_jac(m, d, self._jac, None, point, int(self.foot_bodies[f]))
-                tau -= self._jac.T @ share
+                self._point[:2] = p[:2] + shift
+                self._point[2] = p[2]
+                mj.mj_jac(m, d, self._jac, None, self._point, int(self.foot_bodies[f]))
+                tau -= share * self._jac[2]  # the upward push's generalized force
             self.root_residual = tau[:6].copy()
         return tau[self.vadr]

@@ -22,13 +22,16 @@ from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
 from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, joint_names, segment_mesh
 from .base import System
-from .figure_model import EnvironmentParams, build_model, geom_probe_points, joint_group
+from .figure_model import (AirDrag, EnvironmentParams, build_model, geom_probe_points,
+                           joint_group)
 
 LEG_GROUPS = ("hip", "knee", "ankle", "toe")
 FEET = ("l_foot", "l_toes", "r_foot", "r_toes")
 HANDS = ("l_hand", "r_hand")
 BALANCE_RATE = 0.5  # rad/s, fastest change of the balance offset
 BALANCE_MAX = 0.25  # rad, largest balance offset
+# MjData arrays a snapshot keeps: the state, the servo reference and its rate, the held drag
+STATE_ARRAYS = ("qpos", "qvel", "act", "ctrl", "qfrc_applied", "qacc_warmstart")
 
 
 @dataclass(frozen=True)
@@ -128,9 +131,19 @@ class Figure(System):
         self.balance_offset = 0.0
         self._blend = None
         feet = [SEGMENTS.index(f) for f in ("l_foot", "r_foot")]
-        self.foot_contact_geoms = [self.seg_geom[[k, k + 1]] for k in feet]  # sole and toes
+        # geom id -> which foot (0 left, 1 right) its sole or toes belong to, -1 for none;
+        # geom id -> is a hand: contact tests by table lookup, no set operations per tick
+        self._geom_foot = np.full(m.ngeom, -1, dtype=np.int64)
+        for side, k in enumerate(feet):
+            self._geom_foot[self.seg_geom[[k, k + 1]]] = side
+        self._geom_hand = np.zeros(m.ngeom, dtype=bool)
+        self._geom_hand[self.hand_geoms] = True
+        self._geom_sole = np.full(m.ngeom, -1, dtype=np.int64)
+        self._geom_sole[self.sole_geoms] = (0, 1)
         self.gravity = GravityCompensation(m, self.qadr, self.vadr, self.seg_body[feet],
                                            self.seg_geom[feet], self.free)
+        self.drag = (AirDrag(m, self.seg_body, params.environment.air_density)
+                     if params.environment.air_density > 0 else None)
         self._c0, self._dc, self._ff = np.zeros(len(jid)), np.zeros(len(jid)), np.zeros(len(jid))
         self._tick = 0.0
         if self.fsm is not None:
@@ -171,14 +184,15 @@ class Figure(System):
             return np.zeros(len(target))
         feet = np.zeros(0, np.int64)
         if self.free:
-            geoms = self.data.contact.geom[:self.data.ncon]
-            feet = np.flatnonzero([np.isin(g, geoms).any() for g in self.foot_contact_geoms])
+            owner = self._geom_foot[self.data.contact.geom[:self.data.ncon]]
+            feet = np.flatnonzero(np.bincount(owner[owner >= 0], minlength=2))
         return self.gravity.torques(self.data.qpos, target, feet)
 
     def _plan(self, t):
-        """The servo reference over the control period from t (s): the actuators' ctrl
-        (kp theta_d + kd thetadot_d + tau_g) at both ends; every MuJoCo step in between
-        interpolates it linearly (``_run``), so targets never jump by a whole period's change."""
+        """The servo reference over the control period from t (s): kp theta_d + kd thetadot_d
+        + tau_g at both ends; the actuators' integrator state starts at the first and its
+        rate (ctrl) carries it to the second, so every MuJoCo step in between sees the
+        reference interpolated linearly and targets never jump by a whole period's change."""
         th0, w0 = self._reference(t)
         th1, w1 = self._reference(t + self.control_dt)
         ff1 = self._feedforward(th1)
@@ -186,7 +200,8 @@ class Figure(System):
         self._dc[:] = self.kp * th1 + self.kd * w1 + ff1 - self._c0
         self._ff[:] = ff1
         self._tick = t
-        self.data.ctrl[:] = self._c0
+        self.data.act[:] = self._c0
+        self.data.ctrl[:] = self._dc / self.control_dt
 
     def angles(self) -> np.ndarray:
         """Current joint angles (rad), in ``joints`` order."""
@@ -222,8 +237,8 @@ class Figure(System):
         geoms = d.contact.geom[:d.ncon]
         self._mj.mj_subtreeVel(m, d)
         com = d.subtree_com[self.root].copy()
-        return {"foot_contact": bool(np.isin(geoms, self.foot_geoms).any()),
-                "hand_contact": bool(np.isin(geoms, self.hand_geoms).any()),
+        return {"foot_contact": bool((self._geom_foot[geoms] >= 0).any()),
+                "hand_contact": bool(self._geom_hand[geoms].any()),
                 "com": com, "com_vel": d.subtree_linvel[self.root].copy(),
                 "com_ahead": float(np.dot(com - d.geom_xpos[self.sole_geoms].mean(axis=0),
                                           self._forward()))}
@@ -244,6 +259,8 @@ class Figure(System):
         if self._blend is not None and t >= self._blend[2] + self._blend[3]:
             self._blend = None
         self._plan(t)
+        if self.drag is not None:
+            self.drag.apply(self.data, self.data.qfrc_applied)
         self._next_control += self.control_dt
 
     def _balance(self, s) -> float:
@@ -254,7 +271,8 @@ class Figure(System):
         it off its feet; it is capped at BALANCE_MAX."""
         d = self.data
         geoms = d.contact.geom[:d.ncon]
-        touching = self.sole_geoms[np.isin(self.sole_geoms, geoms)]
+        owner = self._geom_sole[geoms]
+        touching = self.sole_geoms[np.flatnonzero(np.bincount(owner[owner >= 0], minlength=2))]
         if len(touching) == 0:
             return self.balance_offset
         centre = d.geom_xpos[touching].mean(axis=0)
@@ -286,14 +304,14 @@ class Figure(System):
         m, d, mj = self.model, self.data, self._mj
         if m.opt.timestep != sub:
             m.opt.timestep = sub
-        ctrl, c0, dc, rate = d.ctrl, self._c0, self._dc, 1.0 / self.control_dt
-        for k in range(n):
-            t = self.time + k * sub
+        done = 0
+        while done < n:
+            t = self.time + done * sub
             if t >= self._next_control - 1e-9 * sub:
                 self._control(t)
-            np.multiply(dc, (t - self._tick) * rate, out=ctrl)
-            ctrl += c0
-            mj.mj_step(m, d)
+            k = min(n - done, max(1, math.ceil((self._next_control - t) / sub - 1e-9)))
+            mj.mj_step(m, d, nstep=k)
+            done += k
 
     def _sync(self):
         """Positions, frames and velocities of the segments for the state mj_step ended in
@@ -381,7 +399,7 @@ class Figure(System):
 
     def capture(self):
         d = self.data
-        snap = {k: getattr(d, k).copy() for k in ("qpos", "qvel", "ctrl", "qacc_warmstart")}
+        snap = {k: getattr(d, k).copy() for k in STATE_ARRAYS}
         snap.update(time=np.array(self.time), next_control=np.array(self._next_control),
                     targets=self.targets.copy(), vtargets=self.vtargets.copy(),
                     omega=self.omega.copy(), zeta=self.zeta.copy(),
@@ -395,7 +413,7 @@ class Figure(System):
 
     def restore(self, snap):
         d = self.data
-        for k in ("qpos", "qvel", "ctrl", "qacc_warmstart"):
+        for k in STATE_ARRAYS:
             getattr(d, k)[:] = snap[k]
         self.time = float(snap["time"])
         self._next_control = float(snap["next_control"])

@@ -26,7 +26,7 @@ class EnvironmentParams:
     """What the figure stands on. floor: height (m) of a ground plane, None for none; platform:
     (x_min, x_max, y_min, y_max, top) m of a static deck whose top face is at z = top, () for
     none; friction: Coulomb coefficient of the feet on them (-); air_density (kg/m^3): 0 for
-    none, else MuJoCo's quadratic drag on each segment's equivalent inertia box (air: 1.2)."""
+    none, else quadratic drag on each segment's equivalent inertia box (``AirDrag``; air 1.2)."""
     floor: float | None = 0.0  # m
     platform: tuple = ()  # m
     friction: float = 1.0
@@ -49,7 +49,6 @@ def build_model(plan: list[Segment], env: EnvironmentParams, dt: float, root=(0.
     spec.option.timestep = dt
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = [0.0, 0.0, -9.81 if gravity else 0.0]
-    spec.option.density = float(env.air_density)
     world = spec.worldbody
     wkw = dict(contype=WORLD_GROUP, conaffinity=FIGURE_GROUP, friction=[env.friction, 0.005, 1e-4])
     if env.floor is not None:
@@ -87,9 +86,14 @@ def build_model(plan: list[Segment], env: EnvironmentParams, dt: float, root=(0.
             lim = TORQUE_LIMITS[joint_group(jname)] * scale
             act = spec.add_actuator(name=jname, target=jname,
                                     trntype=mujoco.mjtTrn.mjTRN_JOINT)
-            # tau = 1 * ctrl + b1 theta + b2 thetadot with ctrl = g_s theta_d + g_d thetadot_d,
-            # b1 = -g_s, b2 = -g_d: exactly the PD law; MuJoCo's implicitfast integrates the
-            # -g_d thetadot term implicitly, which keeps stiff stance gains stable.
+            # tau = 1 * act + b1 theta + b2 thetadot with act = g_s theta_d + g_d thetadot_d +
+            # tau_g (the servo reference), b1 = -g_s, b2 = -g_d: exactly the PD law plus the
+            # gravity feed-forward; MuJoCo's implicitfast integrates the -g_d thetadot term
+            # implicitly, which keeps stiff stance gains stable. act is an integrator state
+            # (d act/dt = ctrl): the controller sets act at its ticks and ctrl to the
+            # reference's rate, so MuJoCo moves the reference at every step without Python.
+            act.dyntype = mujoco.mjtDyn.mjDYN_INTEGRATOR
+            act.actlimited = mujoco.mjtLimited.mjLIMITED_FALSE
             act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
             act.gainprm[0] = 1.0
             act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
@@ -134,3 +138,56 @@ def geom_probe_points(model, geom_ids):
         gid += [g] * len(local)
         rad += [r] * len(local)
     return np.concatenate(pts), np.array(gid), np.array(rad)
+
+
+class AirDrag:
+    """Quadratic air drag on a figure's segments: F_b = -1/2 rho A_b(v) |v_b| v_b at each
+    segment's centre of mass, A_b the area its equivalent inertia box (the box of its mass and
+    principal inertia, as in MuJoCo's inertia fluid model) shows to the flow, drag coefficient
+    1. Stateless and cheap: the figure evaluates it at its control ticks and holds it as a
+    generalized force (qfrc_applied) in between, since drag changes over tenths of a second.
+    (MuJoCo's own fluid model would add its force derivatives to every implicit step, doubling
+    the figure's cost for a force this small.)"""
+
+    def __init__(self, model, bodies, density: float):
+        self.bodies = np.asarray(bodies, dtype=np.int64)
+        self.density = float(density)
+        m = model.body_mass[self.bodies]
+        I = model.body_inertia[self.bodies]
+        # full box sides from I_x = m (b^2 + c^2) / 12 and its permutations
+        sides = np.sqrt(np.maximum(6.0 * (I.sum(axis=1)[:, None] - 2.0 * I) / m[:, None], 0.0))
+        self.faces = np.stack([sides[:, 1] * sides[:, 2], sides[:, 0] * sides[:, 2],
+                               sides[:, 0] * sides[:, 1]], axis=1)  # m^2, normal to x, y, z
+        if len(set(model.body_rootid[self.bodies])) != 1:
+            raise ParameterError("air drag needs the figure's segments in one kinematic tree")
+        self.root = int(model.body_rootid[self.bodies[0]])
+        # dof j moves body b when j's body is b or one of its ancestors
+        self.moves = np.zeros((model.nv, len(self.bodies)))
+        for k, b in enumerate(self.bodies):
+            a = int(b)
+            while a > 0:
+                self.moves[model.body_dofadr[a]:model.body_dofadr[a] + model.body_dofnum[a],
+                           k] = 1.0
+                a = int(model.body_parentid[a])
+        self.force = np.zeros((len(self.bodies), 3))
+
+    def apply(self, data, qfrc):
+        """Write the drag's generalized force (N, N m) for the current velocities into qfrc:
+        Q_j = cdof_j . (r_b x F_b, F_b) summed over the bodies dof j moves, in MuJoCo's
+        com-based frame (about the tree's centre of mass c, world axes; r_b = x_b - c)."""
+        b = self.bodies
+        cv = data.cvel[b]
+        r = data.xipos[b] - data.subtree_com[self.root]
+        v = cv[:, 3:] + _cross(cv[:, :3], r)
+        local = np.abs(np.matmul(v[:, None, :], data.ximat[b].reshape(-1, 3, 3))[:, 0])
+        area_speed = (local * self.faces).sum(axis=1)  # A |v|, per body along its box axes
+        f = self.force
+        np.multiply(v, (-0.5 * self.density) * area_speed[:, None], out=f)
+        spatial = np.concatenate([_cross(r, f), f], axis=1)  # (torque about c, force)
+        np.sum((data.cdof @ spatial.T) * self.moves, axis=1, out=qfrc)
+
+
+def _cross(a, b):
+    """Row-wise cross products of (n,3) arrays (np.cross costs more for a few rows)."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
