@@ -30,6 +30,7 @@ FEET = ("l_foot", "l_toes", "r_foot", "r_toes")
 HANDS = ("l_hand", "r_hand")
 BALANCE_RATE = 0.5  # rad/s, fastest change of the balance offset
 BALANCE_MAX = 0.25  # rad, largest balance offset
+DRAG_TICKS = 4  # control ticks the air drag is held for (20 ms: drag changes over seconds)
 # MjData arrays a snapshot keeps: the state, the servo reference and its rate, the held drag
 STATE_ARRAYS = ("qpos", "qvel", "act", "ctrl", "qfrc_applied", "qacc_warmstart")
 
@@ -53,13 +54,6 @@ class FigureParams:
     zeta: float = 1.0
     support_omega: float = 8.0  # rad/s
     gravity_compensation: bool = True
-
-
-def _qmul(a, b):
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
 
 
 class Figure(System):
@@ -153,6 +147,7 @@ class Figure(System):
         self._plan(0.0)
         nq = m.nq
         self._gx, self._gv = np.zeros(nq), np.zeros(nq)
+        self._qdot, self._w = np.zeros(4), np.zeros(4)
         self._probe = geom_probe_points(m, self.seg_geom)
 
     # --- servos and control ------------------------------------------------------------------
@@ -259,7 +254,7 @@ class Figure(System):
         if self._blend is not None and t >= self._blend[2] + self._blend[3]:
             self._blend = None
         self._plan(t)
-        if self.drag is not None:
+        if self.drag is not None and round(t / self.control_dt) % DRAG_TICKS == 0:
             self.drag.apply(self.data, self.data.qfrc_applied)
         self._next_control += self.control_dt
 
@@ -354,8 +349,9 @@ class Figure(System):
         """Height (m) of the figure's lowest surface point."""
         pts, gid, rad = self._probe
         d = self.data
-        R = d.geom_xmat[gid].reshape(-1, 3, 3)
-        z = d.geom_xpos[gid, 2] + np.einsum("pj,pj->p", R[:, 2, :], pts) - rad
+        # the z row of each geom's rotation (xmat is row-major: entries 6..8) dotted with the
+        # local probe points
+        z = d.geom_xpos[gid, 2] + (d.geom_xmat[gid, 6:9] * pts).sum(axis=1) - rad
         return float(z.min())
 
     def segment_wrenches(self) -> np.ndarray:
@@ -376,7 +372,10 @@ class Figure(System):
         self._gx[:] = d.qpos
         if self.free:
             self._gv[:3] = d.qvel[:3]
-            self._gv[3:7] = 0.5 * _qmul(d.qpos[3:7], np.concatenate([[0.0], d.qvel[3:6]]))
+            # d q / dt = q (0, w) / 2 with w the body-frame angular velocity
+            self._w[1:] = d.qvel[3:6]
+            self._mj.mju_mulQuat(self._qdot, d.qpos[3:7], self._w)
+            self._gv[3:7] = 0.5 * self._qdot
             self._gv[7:] = d.qvel[6:]
         else:
             self._gv[:] = d.qvel
@@ -391,7 +390,9 @@ class Figure(System):
             d.qpos[3:7] = q
             d.qvel[:3] = xdot[:3]
             # body-frame angular velocity: w = 2 conj(q) qdot (vector part)
-            d.qvel[3:6] = 2.0 * _qmul(q * [1.0, -1.0, -1.0, -1.0], xdot[3:7])[1:]
+            w = np.zeros(4)
+            self._mj.mju_mulQuat(w, q * [1.0, -1.0, -1.0, -1.0], np.asarray(xdot[3:7], float))
+            d.qvel[3:6] = 2.0 * w[1:]
             d.qvel[6:] = xdot[7:]
         else:
             d.qvel[:] = xdot

@@ -144,7 +144,7 @@ class AirDrag:
     """Quadratic air drag on a figure's segments: F_b = -1/2 rho A_b(v) |v_b| v_b at each
     segment's centre of mass, A_b the area its equivalent inertia box (the box of its mass and
     principal inertia, as in MuJoCo's inertia fluid model) shows to the flow, drag coefficient
-    1. Stateless and cheap: the figure evaluates it at its control ticks and holds it as a
+    1. Stateless and cheap: the figure evaluates it every few control ticks and holds it as a
     generalized force (qfrc_applied) in between, since drag changes over tenths of a second.
     (MuJoCo's own fluid model would add its force derivatives to every implicit step, doubling
     the figure's cost for a force this small.)"""
