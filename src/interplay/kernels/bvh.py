@@ -67,25 +67,28 @@ def build(x, elems):
     return left, right, prim
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def refit(lo, hi, left, right, prim, elems, x0, x1, pad):
     """Boxes of every node: each leaf bounds its element at both x0 and x1 (the start and end of
     the step, so a contact during the step is not missed), grown by pad (m); interior nodes
-    bound their children."""
+    bound their children. Leaves in parallel (each writes its own box), then the interior
+    nodes backwards (children are numbered after their parents)."""
     k = elems.shape[1]
-    for node in range(lo.shape[0] - 1, -1, -1):
+    for node in prange(lo.shape[0]):
         e = prim[node]
-        if e >= 0:
-            for r in range(3):
-                a = np.inf
-                b = -np.inf
-                for j in range(k):
-                    p = elems[e, j]
-                    a = min(a, x0[p, r], x1[p, r])
-                    b = max(b, x0[p, r], x1[p, r])
-                lo[node, r] = a - pad
-                hi[node, r] = b + pad
-        else:
+        if e < 0:
+            continue
+        for r in range(3):
+            a = np.inf
+            b = -np.inf
+            for j in range(k):
+                p = elems[e, j]
+                a = min(a, x0[p, r], x1[p, r])
+                b = max(b, x0[p, r], x1[p, r])
+            lo[node, r] = a - pad
+            hi[node, r] = b + pad
+    for node in range(lo.shape[0] - 1, -1, -1):
+        if prim[node] < 0:
             ln, rn = left[node], right[node]
             for r in range(3):
                 lo[node, r] = min(lo[ln, r], lo[rn, r])
@@ -127,6 +130,35 @@ def _box_dist2(p, lo, hi, node):
     return d2
 
 
+@njit(cache=True, inline="always")
+def _nearest_one(p, i, radius, lo, hi, left, right, prim, tris, x, skip_incident, st):
+    """Nearest triangle to point p (index i) within radius: (triangle or -1, squared distance,
+    barycentric weights). st: a scratch stack."""
+    best = radius * radius
+    bt = -1
+    b0, b1, b2 = 0.0, 0.0, 0.0
+    st[0] = 0
+    top = 1
+    while top > 0:
+        top -= 1
+        node = st[top]
+        if _box_dist2(p, lo, hi, node) > best:
+            continue
+        e = prim[node]
+        if e < 0:
+            st[top] = left[node]
+            st[top + 1] = right[node]
+            top += 2
+            continue
+        ia, ib, ic = tris[e, 0], tris[e, 1], tris[e, 2]
+        if skip_incident and (ia == i or ib == i or ic == i):
+            continue
+        u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
+        if d2 <= best:
+            best, bt, b0, b1, b2 = d2, e, u, v, w
+    return bt, best, b0, b1, b2
+
+
 @njit(cache=True, parallel=True)
 def nearest_triangles(pts, radius, lo, hi, left, right, prim, tris, x, skip_incident,
                       out_tri, out_d, out_bary):
@@ -134,34 +166,16 @@ def nearest_triangles(pts, radius, lo, hi, left, right, prim, tris, x, skip_inci
     distance (m) and barycentric weights of the closest point. skip_incident: ignore triangles
     having the point (same index) as a vertex (a network against itself). Race-free: each
     point writes only its own row."""
-    for i in prange(pts.shape[0]):
-        p = pts[i]
-        best = radius * radius
-        bt = -1
-        b0, b1, b2 = 0.0, 0.0, 0.0
+    n = pts.shape[0]
+    chunk = 256  # points per task, sharing one scratch stack (no allocation per point)
+    for c in prange((n + chunk - 1) // chunk):
         st = np.empty(STACK, np.int64)
-        st[0] = 0
-        top = 1
-        while top > 0:
-            top -= 1
-            node = st[top]
-            if _box_dist2(p, lo, hi, node) > best:
-                continue
-            e = prim[node]
-            if e < 0:
-                st[top] = left[node]
-                st[top + 1] = right[node]
-                top += 2
-                continue
-            ia, ib, ic = tris[e, 0], tris[e, 1], tris[e, 2]
-            if skip_incident and (ia == i or ib == i or ic == i):
-                continue
-            u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
-            if d2 <= best:
-                best, bt, b0, b1, b2 = d2, e, u, v, w
-        out_tri[i] = bt
-        out_d[i] = np.sqrt(best) if bt >= 0 else np.inf
-        out_bary[i, 0], out_bary[i, 1], out_bary[i, 2] = b0, b1, b2
+        for i in range(c * chunk, min(n, (c + 1) * chunk)):
+            bt, d2, b0, b1, b2 = _nearest_one(pts[i], i, radius, lo, hi, left, right, prim,
+                                              tris, x, skip_incident, st)
+            out_tri[i] = bt
+            out_d[i] = np.sqrt(d2) if bt >= 0 else np.inf
+            out_bary[i, 0], out_bary[i, 1], out_bary[i, 2] = b0, b1, b2
 
 
 @njit(cache=True, inline="always")

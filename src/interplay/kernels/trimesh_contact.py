@@ -15,21 +15,28 @@ import numpy as np
 from numba import njit, prange
 
 
+@njit(cache=True, inline="always")
+def _dot(ax, ay, az, bx, by, bz):
+    return ax * bx + ay * by + az * bz
+
+
 @njit(cache=True)
 def closest_on_triangle(p, a, b, c):
     """Barycentric weights (u, v, w) of the point of triangle abc closest to p, and the squared
-    distance (Ericson, Real-Time Collision Detection 5.1.5: Voronoi regions of the features)."""
-    ab = b - a
-    ac = c - a
-    ap = p - a
-    d1 = ab @ ap
-    d2 = ac @ ap
+    distance (Ericson, Real-Time Collision Detection 5.1.5: Voronoi regions of the features).
+    Scalar arithmetic only: this runs for every leaf a query reaches, and temporary arrays
+    would dominate its cost."""
+    abx, aby, abz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    acx, acy, acz = c[0] - a[0], c[1] - a[1], c[2] - a[2]
+    apx, apy, apz = p[0] - a[0], p[1] - a[1], p[2] - a[2]
+    d1 = _dot(abx, aby, abz, apx, apy, apz)
+    d2 = _dot(acx, acy, acz, apx, apy, apz)
     if d1 <= 0.0 and d2 <= 0.0:
         u, v, w = 1.0, 0.0, 0.0
     else:
-        bp = p - b
-        d3 = ab @ bp
-        d4 = ac @ bp
+        bpx, bpy, bpz = p[0] - b[0], p[1] - b[1], p[2] - b[2]
+        d3 = _dot(abx, aby, abz, bpx, bpy, bpz)
+        d4 = _dot(acx, acy, acz, bpx, bpy, bpz)
         vc = d1 * d4 - d3 * d2
         if d3 >= 0.0 and d4 <= d3:
             u, v, w = 0.0, 1.0, 0.0
@@ -37,9 +44,9 @@ def closest_on_triangle(p, a, b, c):
             t = d1 / (d1 - d3)
             u, v, w = 1.0 - t, t, 0.0
         else:
-            cp = p - c
-            d5 = ab @ cp
-            d6 = ac @ cp
+            cpx, cpy, cpz = p[0] - c[0], p[1] - c[1], p[2] - c[2]
+            d5 = _dot(abx, aby, abz, cpx, cpy, cpz)
+            d6 = _dot(acx, acy, acz, cpx, cpy, cpz)
             vb = d5 * d2 - d1 * d6
             va = d3 * d6 - d5 * d4
             if d6 >= 0.0 and d5 <= d6:
@@ -55,9 +62,10 @@ def closest_on_triangle(p, a, b, c):
                 v = vb / den
                 w = vc / den
                 u = 1.0 - v - w
-    q = u * a + v * b + w * c
-    d = p - q
-    return u, v, w, d @ d
+    dx = p[0] - (u * a[0] + v * b[0] + w * c[0])
+    dy = p[1] - (u * a[1] + v * b[1] + w * c[1])
+    dz = p[2] - (u * a[2] + v * b[2] + w * c[2])
+    return u, v, w, dx * dx + dy * dy + dz * dz
 
 
 @njit(cache=True)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, replace
 from ..geometry.net import NetParams, basketball_net
 from ..interactions.contact import ContactParams, SphereCordContact, SpherePlaneContact
 from ..interactions.standins import DampingField, DampingFieldParams
+from ..errors import ParameterError
 from ..scene import Scene
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
@@ -34,6 +35,11 @@ class BasketballParams:
     # s: forces are exchanged every coupling_dt; the net sub-cycles the ball contact inside it.
     # Set it to the net's dt for strict lock step (the reference).
     coupling_dt: float = 1e-3
+    # "cords": the specialised sphere-cord contact (sub-cycled in the net's kernel); "mesh":
+    # the general MeshContact between the ball's icosphere (mesh_subdivisions) and the cords as
+    # segments, exchanged every net step (lock step: it is not sub-cycled), docs/collision.md
+    contact_model: str = "cords"
+    mesh_subdivisions: int = 3
 
 
 PARAMS = BasketballParams
@@ -61,8 +67,21 @@ def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
     floor = scene.add(StaticPlane("floor", height=0.0))
     field_ = DampingField(net.x, net.segments(), params.field, thickness=net_p.cord_radius)
     contact = replace(params.contact, thickness=net_p.cord_radius)
-    scene.connect(SphereCordContact("ball-net", ball, net, contact, mode=coupling,
-                                    standin=field_))
+    if params.contact_model == "mesh":
+        from ..interactions.mesh_contact import MeshContact, MeshContactParams
+        scene.coupling_dt = net.dt
+        # the sphere-cord contact's law, and no skin: like it, touch only inside the thickness
+        mp = MeshContactParams(thickness=contact.thickness, friction=contact.friction,
+                               eps=contact.eps, stiffness=contact.stiffness,
+                               damping=contact.damping, constraint=contact.constraint, skin=0.0)
+        scene.connect(MeshContact("ball-net", ball, net, mp, mode=coupling, standin=field_,
+                                  surfaces={"ball": ball.surface(params.mesh_subdivisions)}))
+    elif params.contact_model == "cords":
+        scene.connect(SphereCordContact("ball-net", ball, net, contact, mode=coupling,
+                                        standin=field_))
+    else:
+        raise ParameterError(f"basketball: contact_model must be 'cords' or 'mesh', got "
+                             f"{params.contact_model!r}")
     scene.connect(SpherePlaneContact("ball-floor", ball, floor, params.floor))
     scene.primary = ball
     scene.checkpoints = {"ball": CHECKPOINTS}
