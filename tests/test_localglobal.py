@@ -38,7 +38,7 @@ def test_lu_solve_matches_the_matrix():
     A = (sp.diags(net.m * (1 + h * alpha)) + lap).tocsr()[free][:, free]
     b = np.random.default_rng(0).normal(size=(int(free.sum()), 3))
     out = np.empty_like(b)
-    LG.lu_solve(*lu, b, np.empty_like(b), out)
+    LG.ldl_solve(*lu, b, np.empty_like(b), out)
     assert np.allclose(A @ out, b, rtol=0, atol=1e-12 * np.abs(b).max())
     assert np.array_equal(fid[free], np.arange(free.sum())) and np.all(fid[~free] == -1)
 
