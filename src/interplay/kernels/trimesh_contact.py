@@ -153,28 +153,30 @@ def signed_triangle_distance(pts, tri, bary, dist, x, tris, signed, out_s, out_n
     """Signed distance and outward contact normal of each point from its nearest triangle
     (tri[i] >= 0, closest point given by bary). signed: the triangle's winding gives its
     outside (closed or one-sided meshes: a point behind the face is inside, s < 0); otherwise
-    the normal points from the triangle to the point, s = distance."""
+    the normal points from the triangle to the point, s = distance. Scalar arithmetic: no
+    temporaries per point."""
     for i in prange(pts.shape[0]):
         e = tri[i]
         if e < 0:
             continue
-        a, b, c = x[tris[e, 0]], x[tris[e, 1]], x[tris[e, 2]]
-        fn = np.cross(b - a, c - a)
-        fn = fn / np.sqrt(fn @ fn)
-        q = bary[i, 0] * a + bary[i, 1] * b + bary[i, 2] * c
-        u = pts[i] - q
+        ia, ib, ic = tris[e, 0], tris[e, 1], tris[e, 2]
+        abx, aby, abz = x[ib, 0] - x[ia, 0], x[ib, 1] - x[ia, 1], x[ib, 2] - x[ia, 2]
+        acx, acy, acz = x[ic, 0] - x[ia, 0], x[ic, 1] - x[ia, 1], x[ic, 2] - x[ia, 2]
+        nx, ny, nz = aby * acz - abz * acy, abz * acx - abx * acz, abx * acy - aby * acx
+        nl = np.sqrt(nx * nx + ny * ny + nz * nz)
+        nx, ny, nz = nx / nl, ny / nl, nz / nl
         d = dist[i]
-        if d > 1e-9 * (1.0 + np.sqrt((b - a) @ (b - a))):
-            u = u / d
-            if signed and u @ fn < 0.0:
-                out_s[i] = -d
-                out_n[i] = -u
-            else:
-                out_s[i] = d
-                out_n[i] = u
+        if d > 1e-9 * (1.0 + np.sqrt(abx * abx + aby * aby + abz * abz)):
+            b0, b1, b2 = bary[i, 0], bary[i, 1], bary[i, 2]
+            ux = (pts[i, 0] - (b0 * x[ia, 0] + b1 * x[ib, 0] + b2 * x[ic, 0])) / d
+            uy = (pts[i, 1] - (b0 * x[ia, 1] + b1 * x[ib, 1] + b2 * x[ic, 1])) / d
+            uz = (pts[i, 2] - (b0 * x[ia, 2] + b1 * x[ib, 2] + b2 * x[ic, 2])) / d
+            sign = -1.0 if signed and ux * nx + uy * ny + uz * nz < 0.0 else 1.0
+            out_s[i] = sign * d
+            out_n[i, 0], out_n[i, 1], out_n[i, 2] = sign * ux, sign * uy, sign * uz
         else:
             out_s[i] = 0.0
-            out_n[i] = fn
+            out_n[i, 0], out_n[i, 1], out_n[i, 2] = nx, ny, nz
 
 
 @njit(cache=True, parallel=True)
