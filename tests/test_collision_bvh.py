@@ -185,3 +185,34 @@ def test_bad_meshes_are_refused_with_the_fix():
     with pytest.raises(ParameterError, match=r"cloth: contact thickness must be zero or "
                                              r"positive \(m\), got -0.1"):
         BVH(np.eye(3), [[0, 1, 2]], owner="cloth", pad=-0.1)
+
+
+def test_edge_edge_proximity_equals_brute_force():
+    from interplay.kernels.trimesh_contact import closest_segments
+    rng = np.random.default_rng(8)
+    reach = 0.05
+
+    def segments(m):
+        a = rng.uniform(-1, 1, (m, 3))
+        b = a + rng.normal(0, 0.1, (m, 3))
+        b[::7] = a[::7] + 1e-9 * rng.normal(size=3)  # near-degenerate: almost points
+        return np.vstack([a, b]), np.column_stack([np.arange(m), np.arange(m) + m])
+
+    xa, ea = segments(400)
+    xb, eb = segments(300)
+    # each tree grows its boxes by half the reach: boxes of segments closer than reach overlap
+    ta, tb = BVH(xa, ea, pad=reach / 2), BVH(xb, eb, pad=reach / 2)
+    pairs, st, d = ta.edge_contacts(tb, reach)
+    got = {tuple(p): dd for p, dd in zip(pairs, d)}
+    brute = {}
+    for i in range(len(ea)):
+        for j in range(len(eb)):
+            d2 = closest_segments(xa[ea[i, 0]], xa[ea[i, 1]], xb[eb[j, 0]], xb[eb[j, 1]])[2]
+            if d2 <= reach * reach:
+                brute[(i, j)] = np.sqrt(d2)
+    assert set(got) == set(brute) and len(brute) > 20
+    assert all(abs(got[k] - brute[k]) < 1e-12 for k in brute)
+    # the closest points' parameters reproduce the distances
+    p = xa[ea[pairs[:, 0], 0]] + st[:, :1] * (xa[ea[pairs[:, 0], 1]] - xa[ea[pairs[:, 0], 0]])
+    q = xb[eb[pairs[:, 1], 0]] + st[:, 1:] * (xb[eb[pairs[:, 1], 1]] - xb[eb[pairs[:, 1], 0]])
+    assert np.allclose(np.linalg.norm(p - q, axis=1), d, atol=1e-12)
