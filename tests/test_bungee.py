@@ -44,6 +44,7 @@ def runs():
     return {"free": _run(4.6, replace(c, enabled=False)),
             "massless": _run(4.6, replace(c, mass=1e-4)),
             "cord": _run(6.0, c),
+            "still_air": _run(5.0, c, air_density=0.0),
             "lossless": _run(5.0, replace(c, damping=1e-4), air_density=0.0)}
 
 
@@ -51,7 +52,8 @@ def test_leap_leaves_the_platform():
     r = B.leap_trial(B.JumperParams())
     assert r["takeoff"] is not None and r["takeoff"] < 2.5  # both feet off in the leap
     assert r["clear_x"] is not None and r["clear_x"] > 0.3  # past the edge, 1 m below it
-    assert r["touched"] == 0.0  # nothing touches the deck after takeoff
+    assert r["touched"] < 0.02  # s: nothing touches the deck after takeoff (0 here; a toe
+    # brushing the edge for a few ms is the most a nudge of the parameters brings)
     assert r["rise"] > 0.05  # a leap, not a fall: the centre of mass rises first
     assert r["com"][2] < B.BRIDGE - 1.0
 
@@ -69,16 +71,27 @@ def _energy_balance_stretch(c, m):
     return (-b + np.sqrt(b * b + 4 * a * m * G * c.length)) / (2 * a)
 
 
-@pytest.mark.parametrize("run, rel", [("cord", 0.15), ("lossless", 0.04)])
+def _max_stretch(runs, name):
+    return _cord_length(runs[name][1].frames["cord"]["points"], B.CordParams().points).max() \
+        - B.CordParams().length
+
+
+@pytest.mark.parametrize("run, rel", [("still_air", 0.15), ("lossless", 0.05)])
 def test_max_stretch_agrees_with_the_energy_balance(runs, run, rel):
-    # the default run loses energy to the cord's damping and the air (~9 % less stretch);
-    # without them the balance holds to ~1 % (the leap's rise and the body's flip head-down
-    # add a little drop the formula leaves out)
-    scene, result = runs[run]
+    # the balance has no losses: with the cord's damping (no air) the stretch is ~13 % short
+    # of it, with neither damping nor air within ~4 % (the leap's rise, the anchor above the
+    # ankles and the turn head-down add or take a little drop the formula leaves out)
+    scene, _ = runs[run]
     c, m = B.CordParams(), scene.primary.mass
-    stretch = _cord_length(result.frames["cord"]["points"], c.points).max() - c.length
+    stretch = _max_stretch(runs, run)
     assert stretch == pytest.approx(_energy_balance_stretch(c, m), rel=rel)
     assert c.stiffness * stretch > 2.0 * m * G  # arrested: the peak pull > twice his weight
+
+
+def test_air_and_cord_damping_only_take_energy(runs):
+    # the default run adds the air's drag on the diving body (~8 % of the stretch)
+    assert _max_stretch(runs, "cord") < _max_stretch(runs, "still_air") \
+        < _max_stretch(runs, "lossless")
 
 
 def test_cord_arrests_the_fall_and_he_bounces(runs):
@@ -153,7 +166,7 @@ def test_jumper_comes_to_hang():
     assert np.linalg.norm(v[last], axis=1).max() < 1.0  # m/s: the swing
     assert np.ptp(com[last, 0]) < 2.0  # m
     strap = np.hypot(B.STRAP, 0.09)  # m: the cord's end hangs this far above the ankles
-    hang = B.BRIDGE + 0.5 - c.length - scene.primary.mass * G / c.stiffness - strap
+    hang = B.BRIDGE + B.ANCHOR_HEIGHT - c.length - scene.primary.mass * G / c.stiffness - strap
     ankles = result.frames["cord"]["points"][-1, -2:, 2].mean()
     assert ankles == pytest.approx(hang, abs=0.3)
 
@@ -161,5 +174,5 @@ def test_jumper_comes_to_hang():
 @pytest.mark.slow
 def test_leap_search_improves_a_poor_leap():
     start = replace(B.JumperParams(), depth=0.4, lead=0.0, power=0.6)
-    best, res = B.tune_leap(40, seed=1, start=start)
+    best, res = B.tune_leap(30, seed=1, start=start)
     assert res.loss < res.history[0][1] - 0.2

@@ -4,6 +4,8 @@ The law, on every controlled joint axis:
 
     tau = g_s (theta_d - theta) + g_d (thetadot_d - thetadot),   |tau| <= tau_max
 
+(the figure adds the gravity feed-forward tau_g of control/gravity.py inside the limit)
+
 with gains from the inertia I_eff (kg m^2) the joint moves about its axis, a natural
 frequency w (rad/s) and a damping ratio zeta:
 
