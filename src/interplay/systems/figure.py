@@ -22,8 +22,7 @@ from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
 from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, joint_names, segment_mesh
 from .base import System
-from .figure_model import (AirDrag, EnvironmentParams, build_model, geom_probe_points,
-                           joint_group)
+from .figure_model import AirDrag, EnvironmentParams, build_model, geom_extents, joint_group
 
 LEG_GROUPS = ("hip", "knee", "ankle", "toe")
 FEET = ("l_foot", "l_toes", "r_foot", "r_toes")
@@ -148,7 +147,7 @@ class Figure(System):
         nq = m.nq
         self._gx, self._gv = np.zeros(nq), np.zeros(nq)
         self._qdot, self._w = np.zeros(4), np.zeros(4)
-        self._probe = geom_probe_points(m, self.seg_geom)
+        self._extent, self._round = geom_extents(m, self.seg_geom)
 
     # --- servos and control ------------------------------------------------------------------
     def apply_gains(self):
@@ -347,11 +346,10 @@ class Figure(System):
 
     def lowest_z(self) -> float:
         """Height (m) of the figure's lowest surface point."""
-        pts, gid, rad = self._probe
-        d = self.data
-        # the z row of each geom's rotation (xmat is row-major: entries 6..8) dotted with the
-        # local probe points
-        z = d.geom_xpos[gid, 2] + (d.geom_xmat[gid, 6:9] * pts).sum(axis=1) - rad
+        d, g = self.data, self.seg_geom
+        # xmat is row-major: entries 6..8 are the z row of each geom's rotation
+        z = (d.geom_xpos[g, 2] - (np.abs(d.geom_xmat[g, 6:9]) * self._extent).sum(axis=1)
+             - self._round)
         return float(z.min())
 
     def segment_wrenches(self) -> np.ndarray:

@@ -115,29 +115,22 @@ def build_model(plan: list[Segment], env: EnvironmentParams, dt: float, root=(0.
     return spec.compile()
 
 
-def geom_probe_points(model, geom_ids):
-    """Local points (p,3) m, their geom index and radius (m), whose swept spheres bound each
-    geom exactly along any direction: box corners (radius 0), capsule end centres, sphere
-    centre. Used for the figure's lowest point."""
+def geom_extents(model, geom_ids):
+    """Per geom: half extents (g,3) m along its own axes that reach its surface without the
+    rounding, and the rounding radius (g,) m: a box's half sizes and 0, a capsule's half
+    length on z and its radius, a sphere's nothing and its radius. The geom's lowest point is
+    then z_centre - |R_z| . extents - radius (R_z the z row of its rotation), exactly."""
     import mujoco
-    pts, gid, rad = [], [], []
-    for g in geom_ids:
-        size = model.geom_size[g]
-        t = model.geom_type[g]
+    ext, rad = np.zeros((len(geom_ids), 3)), np.zeros(len(geom_ids))
+    for k, g in enumerate(geom_ids):
+        size, t = model.geom_size[g], model.geom_type[g]
         if t == mujoco.mjtGeom.mjGEOM_BOX:
-            local = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)],
-                             float) * size
-            r = 0.0
+            ext[k] = size
         elif t == mujoco.mjtGeom.mjGEOM_CAPSULE:
-            local = np.array([[0.0, 0.0, -size[1]], [0.0, 0.0, size[1]]])
-            r = size[0]
+            ext[k, 2], rad[k] = size[1], size[0]
         else:
-            local = np.zeros((1, 3))
-            r = size[0]
-        pts.append(local)
-        gid += [g] * len(local)
-        rad += [r] * len(local)
-    return np.concatenate(pts), np.array(gid), np.array(rad)
+            rad[k] = size[0]
+    return ext, rad
 
 
 class AirDrag:
