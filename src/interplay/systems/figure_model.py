@@ -1,7 +1,8 @@
 """The MuJoCo model of a human figure, built in code with ``mujoco.MjSpec`` from the body plan
 (geometry/anthropometry.py): 17 bodies, a free root joint, 30 hinges with anatomical limits,
-one position-velocity servo per hinge, and the static environment (ground plane, platforms)
-the figure stands on. No MJCF file exists to drift from the plan.
+one position-velocity servo per hinge (its reference an integrator state), and the static
+environment (ground plane, platforms) the figure stands on; also the figure's air drag and its
+segments' extents. No MJCF file exists to drift from the plan.
 """
 from __future__ import annotations
 
