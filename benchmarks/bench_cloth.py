@@ -149,7 +149,7 @@ def main():
     runners = {}
     for s in args.solvers:
         if s == "localglobal":
-            runners.update({f"ours-localglobal-{i}it": (lambda n, i=i: ours(n, s, i))
+            runners.update({f"ours-localglobal-{i}it": (lambda n, i=i: ours(n, "localglobal", i))
                             for i in args.lg_iterations})
         elif s != "mujoco":
             runners[f"ours-{s}"] = lambda n, s=s: ours(n, s)

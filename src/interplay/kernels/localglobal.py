@@ -210,7 +210,7 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     """nsteps local/global steps of h seconds with fext (N) held, ``iters`` iterations each.
 
     fid: each point's index among the unknowns, -1 for fixed points; rho: the Chebyshev
-    estimate of the plain iteration's convergence rate (0 for plain iterations). Spheres (k of them):
+    estimate of the plain iteration's convergence rate (0 for plain iterations). Spheres (k):
     centres, velocities, accels (k,3) move along c0 + v t + a t^2/2 over the nsteps; radii (k,);
     params (k,6) as for the network's moving spheres (thickness and mu are used: the contact is
     a projection); impulses (k,7) receives impulse, angular impulse and peak force (N).

@@ -302,8 +302,9 @@ class SpringNetwork(System):
         fid, *lu = self._factors(h / n)
         LG.localglobal_steps(self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k,
                              self.tension_only, self.a_idx, self.a_pos, self.a_k, self.alpha,
-                             self.beta, self.gravity, self.fext, h / n, n, self.lg_iterations, self.lg_rho,
-                             *lu, arr[0], arr[1], arr[3], arr[4], arr[6], self.impulses)
+                             self.beta, self.gravity, self.fext, h / n, n, self.lg_iterations,
+                             self.lg_rho, *lu, arr[0], arr[1], arr[3], arr[4], arr[6],
+                             self.impulses)
 
     def _explicit(self, h, n):
         """n symplectic-Euler steps of h s with the held forces, serial or parallel."""
