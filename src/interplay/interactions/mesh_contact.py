@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
 from ..geometry.bvh import BVH, check_points, check_thickness
+from ..geometry.sphere import icosphere
 from ..kernels.bvh import deepest_on_segments
 from ..kernels.rigid import quat_to_matrix
 from ..kernels.trimesh_contact import respond, signed_triangle_distance
@@ -82,7 +83,10 @@ class _Side:
     def __init__(self, system, surface, p: MeshContactParams, owner):
         self.sys = system
         self.static = not system.dynamic or isinstance(system, (StaticShape, StaticPlane))
-        self.rigid = isinstance(system, RigidBody)
+        # animation (keyframed bodies): a rigid surface that moves as told, infinitely heavy
+        # for the contact and never pushed (accepts_forces False: only one-way applies)
+        self.kinematic = not system.accepts_forces and hasattr(system, "q")
+        self.rigid = isinstance(system, RigidBody) or self.kinematic
         self.net = isinstance(system, SpringNetwork)
         self.tree = None
         if self.static:
@@ -96,6 +100,10 @@ class _Side:
                                      "systems/colliders.py")
             return
         if self.rigid:
+            if surface is None and self.kinematic and hasattr(system, "ellipsoid"):
+                axes, _ = system.ellipsoid()
+                v, t = icosphere(3)
+                surface = (v * axes, t)
             v, t = surface if surface is not None else system.surface()
             self.tree = BVH(v, t, owner=system.name)
             self._reach = np.sqrt((self.tree.body_x ** 2).sum(axis=1).max())  # m, from centre
@@ -121,17 +129,22 @@ class _Side:
         if self.static:
             return
         if self.rigid:
+            self.w = getattr(s, "w", np.zeros(3))  # keyframed bodies do not spin
             self.R = quat_to_matrix(s.q)
             # the end pose of the step: translation predicted, rotation bounded by a pad
             self.tree.transform(self.R, s.x, self.R, s.x + s.v * h)
-            pad = np.linalg.norm(s.w) * h * self._reach + self._pad
+            pad = np.linalg.norm(self.w) * h * self._reach + self._pad
             self.tree.lo -= pad
             self.tree.hi += pad
             self.x = check_points(s.name, self.tree.x)
             r = self.x - s.x
-            self.v = s.v + np.cross(s.w, r)
-            self.a = np.broadcast_to(s.gravity + s.force / s.mass, self.x.shape)
-            self.Iinv = self.R @ np.diag(1.0 / s.inertia_body) @ self.R.T
+            self.v = s.v + np.cross(self.w, r)
+            if self.kinematic:  # prescribed: no acceleration the contact could cancel
+                self.a = np.zeros_like(self.x)
+                self.Iinv = np.zeros((3, 3))
+            else:
+                self.a = np.broadcast_to(s.gravity + s.force / s.mass, self.x.shape)
+                self.Iinv = self.R @ np.diag(1.0 / s.inertia_body) @ self.R.T
         else:
             self.x = check_points(s.name, s.x)
             self.v = s.v
@@ -156,6 +169,8 @@ class _Side:
 
     def point_inverse_mass(self, r, n):
         """Inverse effective mass (1/kg) of a rigid body along n at offsets r from its centre."""
+        if self.kinematic:
+            return np.zeros(len(r))
         rn = np.cross(r, n)
         return 1.0 / self.sys.mass + np.einsum("ij,jk,ik->i", rn, self.Iinv, rn)
 
@@ -247,7 +262,7 @@ class MeshContact(Interaction):
             return np.zeros((k, 3)), np.zeros((k, 3)), np.zeros(k)
         if side.rigid:
             r = xp - side.sys.x
-            return (side.sys.v + np.cross(side.sys.w, r), np.broadcast_to(side.a[0], (k, 3)),
+            return (side.sys.v + np.cross(side.w, r), np.broadcast_to(side.a[0], (k, 3)),
                     side.point_inverse_mass(r, n))
         return (np.einsum("kj,kjd->kd", w, side.v[vid]), np.einsum("kj,kjd->kd", w, side.a[vid]),
                 np.einsum("kj,kj->k", w ** 2, side.winv[vid]))
@@ -334,7 +349,7 @@ class MeshContact(Interaction):
                 if A.rigid:
                     torque += np.cross(xp - A.sys.x, f).sum(axis=0)
             for side, rec in ((P, rec_p), (Q, rec_q)):
-                if rec is None or side.static:
+                if rec is None or side.static or side.kinematic:
                     continue
                 if (side is A and not to_primary) or (side is B and not to_secondary):
                     continue
