@@ -101,9 +101,9 @@ def main():
               "bungee": bench_scene(True, 2.0 if a.quick else 8.0, repeats)}
     result["targets"] = {"figure": 20.0, "bungee": 1.0}
     out = Path(a.out) / "bench_figure.json"
+    result["machine"]["load_average_after"] = list(os.getloadavg())
     with atomic_path(out) as tmp:
         tmp.write_text(json.dumps(result, indent=2))
-    result["machine"]["load_average_after"] = list(os.getloadavg())
     for key, label in (("figure", "figure alone with its controller"),
                        ("figure_advance", "  the same, Figure.advance only"),
                        ("mujoco_only", "MuJoCo mj_step only (no control)"),
