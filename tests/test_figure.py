@@ -106,6 +106,18 @@ def test_pushed_figure_recovers():
     assert f.com()[2] > 0.9 and abs(f.com()[0]) < 0.05
 
 
+def test_sideways_shove_is_absorbed_by_the_two_foot_stance():
+    # balance feedback is sagittal only (ankles); sideways the stance's width and the soft
+    # stance servos with gravity compensation absorb a 12 N s shove at the chest
+    f = Figure("man", FigureParams(body=GYMNAST), Controller((B.stand(),)))
+    for k in range(3000):
+        f.clear_forces()
+        if 500 <= k < 600:
+            f.add_wrench([0.0, 120.0, 0.0], body="torso")
+        f.advance(1e-3)
+    assert f.com()[2] > 0.95 and abs(f.com()[1]) < 0.02
+
+
 def test_generalized_state_round_trip_keeps_the_velocity():
     f = Figure("man", FigureParams(body=GYMNAST))
     f.data.qvel[:] = np.linspace(-1, 1, f.model.nv)
