@@ -103,3 +103,20 @@ def test_servo_reference_moves_at_every_step():
     # inside the blend the reference changes at every 1 ms step, not once per 5 ms tick
     assert np.all(step > 0.0)
     assert step.max() < 3.0 * np.median(step)
+
+
+def test_capture_and_restore_replay_the_controlled_motion_exactly():
+    # the snapshot holds the servo reference (act), its rate (ctrl), the held drag and the
+    # controller's state: a rerun from it repeats the run bit for bit
+    from interplay.scenes import bungee
+    f = bungee.jumper(bungee.JumperParams())
+    for _ in range(1200):  # into the crouch, mid-blend
+        f.advance(1e-3)
+    snap = f.capture()
+    for _ in range(600):  # through the tip and the leap
+        f.advance(1e-3)
+    first = f.data.qpos.copy()
+    f.restore(snap)
+    for _ in range(600):
+        f.advance(1e-3)
+    assert np.array_equal(f.data.qpos, first)
