@@ -127,8 +127,7 @@ class Figure(System):
         # geom id -> which foot (0 left, 1 right) its sole or toes belong to, -1 for none;
         # geom id -> is a hand: contact tests by table lookup, no set operations per tick
         self._geom_foot = np.full(m.ngeom, -1, dtype=np.int64)
-        for side, k in enumerate(feet):
-            self._geom_foot[self.seg_geom[[k, k + 1]]] = side
+        self._geom_foot[self.foot_geoms] = (0, 0, 1, 1)  # FEET: left foot, toes, right ...
         self._geom_hand = np.zeros(m.ngeom, dtype=bool)
         self._geom_hand[self.hand_geoms] = True
         self._geom_sole = np.full(m.ngeom, -1, dtype=np.int64)
