@@ -44,6 +44,12 @@ def test_cube_rests_on_the_ground_through_the_scene():
     assert np.linalg.norm(v[:3]) < 1e-6  # no jitter
     for t in np.arange(1.0, 2.0, 0.1):
         assert res.state_at("cube", t)[0][2] > A + p.thickness - G * H * H
+    # no bounce: after landing (0.94 m/s) it never rises above its resting height; the
+    # critically damped contact (omega = 1/(10 h)) dips at most v/(omega e) = 3.5 mm
+    z = np.array([res.state_at("cube", t)[0][2] for t in np.arange(0.0, 1.0, H)])
+    landed = np.argmax(z < A + p.thickness)
+    assert z[landed:].max() <= A + p.thickness + G * H * H
+    assert z.min() > A + p.thickness - 0.94 / (np.e / (10 * H))
 
 
 def run_slope(theta, mu=0.5, seconds=1.0):
