@@ -85,7 +85,10 @@ class _Side:
         self.static = not system.dynamic or isinstance(system, (StaticShape, StaticPlane))
         # animation (keyframed bodies): a rigid surface that moves as told, infinitely heavy
         # for the contact and never pushed (accepts_forces False: only one-way applies)
-        self.kinematic = not system.accepts_forces and hasattr(system, "q")
+        # an articulated figure (MuJoCo): rigid segments, each with its own mesh
+        self.figure = hasattr(system, "segment_meshes") and hasattr(system, "seg_body")
+        self.kinematic = (not system.accepts_forces and hasattr(system, "q")
+                          and not self.figure)
         self.rigid = isinstance(system, RigidBody) or self.kinematic
         self.net = isinstance(system, SpringNetwork)
         self.tree = None
@@ -108,6 +111,19 @@ class _Side:
             self.tree = BVH(v, t, owner=system.name)
             self._reach = np.sqrt((self.tree.body_x ** 2).sum(axis=1).max())  # m, from centre
             self.signed = True
+        elif self.figure:
+            meshes = system.segment_meshes()
+            self.body_v = np.concatenate([v for v, _ in meshes])
+            sizes = [len(v) for v, _ in meshes]
+            self.seg_of = np.repeat(np.arange(len(meshes)), sizes)
+            base = np.cumsum([0] + sizes[:-1])
+            tris = np.concatenate([t + b for (_, t), b in zip(meshes, base)])
+            self._pose()
+            self.tree = BVH(self.x, tris, owner=system.name)
+            self.signed = True
+            bodies = system.seg_body
+            self.seg_mass = system.model.body_mass[bodies]
+            self._twist = np.zeros(6)
         elif self.net:
             tris = surface[1] if surface is not None else getattr(system, "triangles", None)
             if tris is not None:
@@ -121,14 +137,45 @@ class _Side:
             self.signed = False
         else:
             raise ParameterError(f"{owner}: {system.name} ({type(system).__name__}) cannot "
-                                 "collide through MeshContact; it takes rigid bodies, spring "
-                                 "networks and static colliders")
+                                 "collide through MeshContact; it takes rigid bodies, "
+                                 "figures, keyframed bodies, spring networks and static "
+                                 "colliders")
+
+    def _pose(self):
+        """A figure's world vertices from its segments' poses."""
+        d, b = self.sys.data, self.sys.seg_body
+        self.seg_pos = d.xpos[b][self.seg_of]
+        R = d.xmat[b].reshape(-1, 3, 3)[self.seg_of]
+        self.x = check_points(self.sys.name, np.einsum("vij,vj->vi", R, self.body_v)
+                              + self.seg_pos)
+
+    def _figure_update(self, h):
+        """Segment velocities (MuJoCo's, world frame, at each segment's origin), vertex
+        velocities, and the tree refit over the step (segments move relative to each other,
+        so one tree over the whole figure is refit rather than transformed)."""
+        import mujoco
+        s = self.sys
+        nseg = len(s.seg_body)
+        self.seg_ang = np.empty((nseg, 3))
+        self.seg_lin = np.empty((nseg, 3))
+        for k, b in enumerate(s.seg_body):  # 17 segments: one MuJoCo call each
+            mujoco.mj_objectVelocity(s.model, s.data, mujoco.mjtObj.mjOBJ_BODY, int(b),
+                                     self._twist, 0)
+            self.seg_ang[k], self.seg_lin[k] = self._twist[:3], self._twist[3:]
+        self._pose()
+        r = self.x - self.seg_pos
+        self.v = self.seg_lin[self.seg_of] + np.cross(self.seg_ang[self.seg_of], r)
+        self.a = np.zeros_like(self.x)  # the servos' accelerations are not known here
+        self.tree.refit(self.x, self.x + self.v * h)
 
     def update(self, h):
         """World points, velocities, accelerations and inverse masses; refit or move the tree
         over the step's motion (h s)."""
         s = self.sys
         if self.static:
+            return
+        if self.figure:
+            self._figure_update(h)
             return
         if self.rigid:
             self.w = getattr(s, "w", np.zeros(3))  # keyframed bodies do not spin
@@ -161,8 +208,8 @@ class _Side:
         """A cheap world box (lo, hi) m holding the side's surface over the next h s, for
         skipping the exchange while the two sides are apart; None for static sides."""
         s = self.sys
-        if self.static:
-            return None
+        if self.static or self.figure:
+            return None  # (a figure is always tested: its extent changes with its pose)
         if self.rigid:
             r = self._reach + self._pad + np.linalg.norm(s.v) * h
             return s.x - r, s.x + r
@@ -266,6 +313,13 @@ class MeshContact(Interaction):
             r = xp - side.sys.x
             return (side.sys.v + np.cross(side.w, r), np.broadcast_to(side.a[0], (k, 3)),
                     side.point_inverse_mass(r, n))
+        if side.figure:
+            # the segment's own mass: the joints make the real effective mass larger, so the
+            # contact is a little softer than it could be, never less stable
+            seg = side.seg_of[vid[:, 0]]
+            r = xp - side.sys.data.xpos[side.sys.seg_body[seg]]
+            winv = 1.0 / side.seg_mass[seg] if side.sys.accepts_forces else np.zeros(k)
+            return (side.seg_lin[seg] + np.cross(side.seg_ang[seg], r), np.zeros((k, 3)), winv)
         return (np.einsum("kj,kjd->kd", w, side.v[vid]), np.einsum("kj,kjd->kd", w, side.a[vid]),
                 np.einsum("kj,kj->k", w ** 2, side.winv[vid]))
 
@@ -310,6 +364,15 @@ class MeshContact(Interaction):
         network points by their weights (force w F, Jacobian w^2 J: equal and opposite to the
         other side's in sum)."""
         vid, w, xp, f, jx, jv, vref = rec
+        if side.figure:
+            # force and torque about each segment's centre of mass, one call per segment
+            fig = side.sys
+            seg = side.seg_of[vid[:, 0]]
+            tau = np.cross(xp - fig.data.xipos[fig.seg_body[seg]], f)
+            for k in np.unique(seg):
+                on = seg == k
+                fig.add_wrench(f[on].sum(axis=0), tau[on].sum(axis=0), body=int(k))
+            return
         if side.rigid:
             side.sys.add_wrench(f.sum(axis=0), np.cross(xp - side.sys.x, f).sum(axis=0),
                                 dfdx=jx.sum(axis=0), dfdv=jv.sum(axis=0))
@@ -351,7 +414,7 @@ class MeshContact(Interaction):
                 if A.rigid:
                     torque += np.cross(xp - A.sys.x, f).sum(axis=0)
             for side, rec in ((P, rec_p), (Q, rec_q)):
-                if rec is None or side.static or side.kinematic:
+                if rec is None or side.static or not side.sys.accepts_forces:
                     continue
                 if (side is A and not to_primary) or (side is B and not to_secondary):
                     continue
