@@ -1,16 +1,16 @@
-"""Contact between any two systems with surfaces (SPEC 2.5): rigid bodies, spring-mass networks
-and static colliders, through one path.
+"""Contact between any two systems with surfaces (SPEC 2.5): rigid bodies, articulated figures,
+keyframed bodies, spring-mass networks and static colliders, through one path.
 
-Detection: the points of each side (a network's particles, a rigid body's mesh vertices)
-against the other side's surface: its triangle hierarchy (``geometry.bvh``; refit every
-exchange for a network over the step's motion, transformed for a rigid body) or a static
+Detection: the points of each side (a network's particles, a body's mesh vertices) against
+the other side's surface: its triangle hierarchy (``geometry.bvh``; refit every exchange for
+a network or a figure over the step's motion, transformed for a rigid body) or a static
 shape's signed distance. A rigid body's and a static shape's surface is closed: a point up to
 ``depth`` behind a face is pushed back out, which stops fast objects tunnelling as long as
 they move less than ``depth`` per step. A network's triangles are two-sided sheets of
 ``thickness``.
 Response (kernels/trimesh_contact.respond): stabilized penalty with the constraint term and
-regularized Coulomb friction, at the contact point of both sides, equal and opposite: forces
-split over a triangle's vertices by barycentric weights, or a force and torque on a rigid body.
+Coulomb friction, at the contact point of both sides, equal and opposite: forces split over a
+triangle's vertices by barycentric weights, or a force and torque on a rigid body (segment).
 Stiffness and damping default to values from each contact's effective mass m_eff and the step
 h: c_s = m_eff (1/(n h))^2, c_d = 2 m_eff/(n h) with n = ``contact_steps``: the contact
 resolves over a few steps, critically damped (no bounce), while the constraint term carries
@@ -45,10 +45,10 @@ class MeshContactParams:
     step (see the module docstring); contact_steps: the steps over which a penetration is
     resolved (None: 10 when a rigid body takes part, whose rotation is integrated explicitly
     and sees several contacts' stiffness at once, else 3: a network's point settles an impact
-    within its thickness); constraint: include the constraint term f_c; skin: contacts are kept this far
-    (m) beyond the thickness, where the penalty turns negative and only lightens the
-    constraint force, so a resting contact settles inside it instead of flickering at its
-    edge (and losing its friction spring)."""
+    within its thickness); constraint: include the constraint term f_c; skin: contacts are
+    kept this far (m) beyond the thickness, where the penalty turns negative and only
+    lightens the constraint force, so a resting contact settles inside it instead of
+    flickering at its edge (and losing its friction spring)."""
     thickness: float = 0.005
     depth: float = 0.05
     friction: float = 0.5
