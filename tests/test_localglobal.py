@@ -28,8 +28,8 @@ def hang(net, seconds=0.25, h=0.01):
 def test_lu_solve_matches_the_matrix():
     net = cloth("localglobal", 1 / 60)
     h, alpha, beta = 1 / 60, 0.3, 1e-3
-    fid, *lu = LG.factor(net.m, net.fixed, net.si, net.sj, net.k, net.a_idx, net.a_k, alpha,
-                         beta, h)
+    fid, *lu = LG.factor(net.m, net.fixed, net.si, net.sj, net.k, net.a_idx, net.a_k,
+                         net.a_c, alpha, beta, h)
     n, free = len(net.m), ~net.fixed
     w = (h * h + h * beta) * net.k
     lap = sp.coo_matrix((np.r_[w, w, -w, -w], (np.r_[net.si, net.sj, net.si, net.sj],
@@ -155,3 +155,23 @@ def test_external_forces_and_sphere_projection():
         total += net.impulses[0, :3]
         assert np.linalg.norm(net.x, axis=1).min() >= 0.155 - 1e-12
     assert total[2] < 0 and net.x[:, 2].min() < 0.0  # it drapes around the sphere
+
+
+def test_anchor_spring_and_damping():
+    """A point on a damped zero-length anchor spring under gravity settles at
+    a_pos - m g / k, and its damping (with alpha = 0) is what removes the energy."""
+    x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    s = Springs.from_ratio(x, [(0, 1)], 1.0)
+    def run(c):
+        net = SpringNetwork("a", x, [1.0, 0.2], s, dt=1 / 60, integrator="localglobal",
+                            fixed=[0], anchors=([1], [[1.0, 0.0, 0.0]], 50.0, c))
+        zs = []
+        for _ in range(240):
+            net.advance(1 / 60)
+            zs.append(net.x[1, 2])
+        return np.array(zs), net
+    zs, net = run(2.0)
+    # the cord (1 N/m) pulls up only ~ z^3 / 2 = 3e-5 N against m g = 2 N: the anchor holds
+    assert abs(zs[-1] - (-0.2 * 9.81 / 50.0)) < 1e-4
+    undamped, _ = run(0.0)
+    assert np.ptp(zs[-60:]) < 0.1 * np.ptp(undamped[-60:])

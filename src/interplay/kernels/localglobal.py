@@ -10,7 +10,7 @@ converged step, and undamped cloth then gains energy over seconds (measured in
 tests/test_localglobal.py). The iterations are therefore Chebyshev-accelerated (Wang 2015) with
 an estimated convergence rate rho (0 = plain; 0.95 with 10 iterations kept a 1 m, 200 N,
 16 x 16 cloth's energy falling at 1/60 s; 0.99 with 8 diverged: keep rho <~ 0.97). The global
-matrix A = M (1 + h alpha) + (h^2 + h beta) L + h^2 K_anchor,
+matrix A = M (1 + h alpha) + (h^2 + h beta) L + h^2 K_anchor + h C_anchor,
 L = sum_s k_s (e_a - e_b)(e_a - e_b)^T, does not depend on the state: it is factored once
 (scipy's SuperLU as L D L^T, ``factor``) and every iteration is two triangular solves
 (``ldl_solve``).
@@ -34,11 +34,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 
-def factor(m, fixed, si, sj, k, a_idx, a_k, alpha, beta, h):
+def factor(m, fixed, si, sj, k, a_idx, a_k, a_c, alpha, beta, h):
     """Factor the global matrix over the free points for step h (s).
 
-    m (n,) kg, fixed (n,) bool, springs (si, sj) with k (N/m), anchors a_idx with a_k (N/m),
-    alpha (1/s), beta (s). Returns Numba-ready arrays (free index of each point or -1, then
+    m (n,) kg, fixed (n,) bool, springs (si, sj) with k (N/m), anchors a_idx with a_k (N/m)
+    and a_c (N s/m), alpha (1/s), beta (s). Returns Numba-ready arrays (free index of each point or -1, then
     ``ldl_solve``'s Lp, Li, Lx, dinv, perm).
     """
     n = len(m)
@@ -49,7 +49,7 @@ def factor(m, fixed, si, sj, k, a_idx, a_k, alpha, beta, h):
     Lap = sp.coo_matrix((np.r_[w, w, -w, -w],
                          (np.r_[si, sj, si, sj], np.r_[si, sj, sj, si])), shape=(n, n)).tocsr()
     diag = m * (1.0 + h * alpha)
-    np.add.at(diag, a_idx, h * h * a_k)
+    np.add.at(diag, a_idx, h * h * a_k + h * a_c)
     A = (sp.diags(diag) + Lap).tocsr()[free][:, free].tocsc()
     # A is symmetric positive definite: without row pivoting SuperLU's U is D L^T, so only the
     # unit lower factor and the diagonal are kept (half the memory; at 128^2 the factor then
@@ -203,7 +203,7 @@ def _collide(x, v, m, fixed, c, vc, radius, thickness, mu, imp):
 
 
 @njit(cache=True)
-def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k,
+def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k, a_c,
                       alpha, beta, gravity, fext, h, nsteps, iters, rho,
                       Lp, Li, Lx, dinv, perm,
                       centres, velocities, accels, radii, params, impulses):
@@ -254,7 +254,7 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
             p = fid[a_idx[q]]
             if p >= 0:
                 for r in range(3):
-                    base[p, r] += hh * a_k[q] * a_pos[q, r]
+                    base[p, r] += hh * a_k[q] * a_pos[q, r] + h * a_c[q] * xn[a_idx[q], r]
         for s in range(ns):
             a = si[s]
             b = sj[s]

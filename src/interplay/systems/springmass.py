@@ -286,12 +286,12 @@ class SpringNetwork(System):
     def _factors(self, h):
         """The local/global factorization for step h, rebuilt only when the step, the masses,
         the damping, the springs, the anchors or the fixed set changed."""
-        arrays = (self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k)
+        arrays = (self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k, self.a_c)
         lg = self._lg
         if (lg is None or lg[0] != (h, self.alpha, self.beta)
                 or not all(np.array_equal(a, b) for a, b in zip(arrays, lg[1]))):
             fac = LG.factor(self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k,
-                            self.alpha, self.beta, h)
+                            self.a_c, self.alpha, self.beta, h)
             self._lg = lg = ((h, self.alpha, self.beta), tuple(a.copy() for a in arrays), fac)
             self.lg_factorizations += 1
         return lg[2]
@@ -301,7 +301,8 @@ class SpringNetwork(System):
         arr = self._sphere_arrays()
         fid, *lu = self._factors(h / n)
         LG.localglobal_steps(self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k,
-                             self.tension_only, self.a_idx, self.a_pos, self.a_k, self.alpha,
+                             self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
+                             self.alpha,
                              self.beta, self.gravity, self.fext, h / n, n, self.lg_iterations,
                              self.lg_rho, *lu, arr[0], arr[1], arr[3], arr[4], arr[6],
                              self.impulses)
