@@ -246,7 +246,10 @@ class MeshContact(Interaction):
         self._stretch = {}  # friction springs' stretch (m) per point, by direction
 
     def prepare(self, h):
+        """A pass starts (or reruns from its start): step h (s); friction springs forget
+        contacts from whatever ran before."""
         self._h = h
+        self._stretch.clear()
 
     # --- detection ---------------------------------------------------------------------------
     def _queries(self, P: _Side, Q: _Side):
