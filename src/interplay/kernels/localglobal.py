@@ -145,9 +145,10 @@ def _local(x, si, sj, pa, pb, l0, kk, tension_only, base, rhs):
 
 
 @njit(cache=True)
-def _collide(x, v, m, fixed, c, vc, radius, thickness, mu, imp):
-    """Project points inside a sphere (centre c m, velocity vc m/s) out to radius + thickness,
-    remove their inward normal velocity relative to the sphere and apply Coulomb friction to the
+def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
+    """Project points inside a sphere (centre c m, velocity vc m/s) out to radius + thickness
+    (radially; a point that crossed the centre since the step's start xn goes back out on
+    that side, not out the far side), remove their inward normal velocity relative to the sphere and apply Coulomb friction to the
     tangential one. Adds the impulse and angular impulse on the sphere (N s, N m s) to imp[0:6];
     returns the impulse magnitude."""
     reach = radius + thickness
@@ -161,7 +162,15 @@ def _collide(x, v, m, fixed, c, vc, radius, thickness, mu, imp):
         r1 = x[i, 1] - c[1]
         r2 = x[i, 2] - c[2]
         dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
-        if dist >= reach or dist <= 0.0:
+        if dist >= reach:
+            continue
+        s0 = xn[i, 0] - c[0]
+        s1 = xn[i, 1] - c[1]
+        s2 = xn[i, 2] - c[2]
+        if r0 * s0 + r1 * s1 + r2 * s2 <= 0.0:
+            r0, r1, r2 = s0, s1, s2
+            dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+        if dist <= 0.0:
             continue
         n0 = r0 / dist
         n1 = r1 / dist
@@ -296,7 +305,8 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
                 vc[r] = velocities[q, r] + accels[q, r] * tau
                 imp[r] = 0.0
                 imp[r + 3] = 0.0
-            jm = _collide(x, v, m, fixed, c, vc, radii[q], params[q, 0], params[q, 3], imp)
+            jm = _collide(x, xn, v, m, fixed, c, vc, radii[q], params[q, 0], params[q, 3],
+                          imp)
             for r in range(6):
                 impulses[q, r] += imp[r]
             if jm / h > impulses[q, 6]:
