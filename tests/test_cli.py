@@ -60,7 +60,7 @@ BAD = [
     (["run", "basketball", "--set", "net.colour=red"], "unknown parameter; valid keys"),
     (["run", "basketball", "--set", "ball.mass=heavy"], "expected a float"),
     (["run", "basketball", "--set", "nomass"], "expected KEY=VALUE"),
-    (["run", "basketball", "--integrator", "rk4"], "choose explicit or implicit"),
+    (["run", "basketball", "--integrator", "rk4"], "choose one of explicit, implicit, localglobal"),
     (["run", "basketball", "--integrator", "explicit", "--dt", "1e-3"],
      "above the explicit stability bound"),
     (["run", "basketball", "--duration", "soon"], "invalid float value"),

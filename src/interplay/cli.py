@@ -24,7 +24,8 @@ def _scene_options(p):
     p.add_argument("scene", help="scene name (see `interplay list`)")
     p.add_argument("--duration", type=float, default=None, help="simulated seconds")
     p.add_argument("--fps", type=float, default=60.0, help="output frames per second")
-    p.add_argument("--integrator", default=None, help="explicit | implicit (spring-mass systems)")
+    p.add_argument("--integrator", default=None,
+                   help="explicit | implicit | localglobal (spring-mass systems)")
     p.add_argument("--dt", type=float, default=None, help="spring-mass step in seconds")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter, e.g. --set net.cord_ea=300")
@@ -97,8 +98,10 @@ def _build_kwargs(args):
     if args.duration is not None:
         kw["duration"] = args.duration
     if args.integrator is not None:
-        if args.integrator not in ("explicit", "implicit"):
-            raise ParameterError(f"--integrator {args.integrator}: choose explicit or implicit")
+        from .systems.springmass import INTEGRATORS
+        if args.integrator not in INTEGRATORS:
+            raise ParameterError(f"--integrator {args.integrator}: choose one of "
+                                 f"{', '.join(INTEGRATORS)}")
         kw["integrator"] = args.integrator
     if args.dt is not None:
         kw["dt"] = args.dt
