@@ -14,7 +14,7 @@ from ..geometry.bvh import BVH, check_points
 from ..geometry.sphere import icosphere
 from ..kernels.trimesh_contact import (box_distance, capsule_distance,
                                        signed_triangle_distance)
-from .base import System
+from .static import Stateless
 
 
 def box_surface(half):
@@ -26,30 +26,8 @@ def box_surface(half):
     return v, np.array(t, dtype=np.int64)
 
 
-class StaticShape(System):
+class StaticShape(Stateless):
     """Base of immovable colliders: mass inf, no state, never stepped."""
-
-    kind = "static"
-    dynamic = False
-
-    def __init__(self, name):
-        super().__init__(name, dt=1.0)
-
-    @property
-    def mass(self):
-        return np.inf
-
-    def step(self, h):
-        pass
-
-    def generalized_state(self):
-        return np.zeros(0), np.zeros(0)
-
-    def set_generalized_state(self, x, xdot):
-        pass
-
-    def frame(self):
-        return {}
 
     def distance(self, points):
         """Signed distance (n,) m and outward unit normals (n,3) of points (n,3)."""

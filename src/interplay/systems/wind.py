@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import ParameterError, require_nonnegative
 from ..kernels import wind as K
-from .base import System
+from .static import Stateless
 
 KINDS = {"uniform": K.UNIFORM, "source": K.SOURCE, "sink": K.SOURCE, "vortex": K.VORTEX}
 
@@ -65,24 +65,15 @@ class FlowPrimitive:
         return 1.0 + self.gust * g
 
 
-class WindField(System):
-    """The air: a static system (never stepped by the scheduler, infinitely massive) whose
-    ``velocity(points, t)`` any interaction may sample. dt is irrelevant (its state is a
-    function of time)."""
+class WindField(Stateless):
+    """The air: a stateless system (never stepped by the scheduler, infinitely massive) whose
+    ``velocity(points, t)`` any interaction may sample; it is a function of time."""
 
     kind = "wind"
-    dynamic = False
 
     def __init__(self, name="wind", primitives=()):
-        super().__init__(name, dt=1.0)
+        super().__init__(name)
         self.primitives = [p.checked(name) for p in primitives]
-
-    @property
-    def mass(self):
-        return np.inf
-
-    def step(self, h):
-        self.time += h
 
     def arrays(self, t: float):
         """(kind, centre, axis, strength, core) arrays of the primitives at time t."""
@@ -109,12 +100,3 @@ class WindField(System):
         out = np.empty_like(pts)
         K.sample(pts, *self.arrays(t), out)
         return out
-
-    def generalized_state(self):
-        return np.zeros(0), np.zeros(0)
-
-    def set_generalized_state(self, x, xdot):
-        pass
-
-    def frame(self):
-        return {}
