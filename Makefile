@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_THREADING_LAYER ?= workqueue
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: demo test test-all bench clean sysdeps browser
+.PHONY: clean-numba demo test test-all bench clean sysdeps browser
 
 # The preview renderer needs Mesa's EGL driver (headless OpenGL on the CPU); the slow browser
 # tests need Chromium. apt runs only when something is missing, and only as root.
@@ -46,3 +46,7 @@ bench: $(STAMP)
 
 clean:
 	rm -rf $(VENV) out .pytest_cache build src/*.egg-info
+
+# Numba's cache does not track kernels called across modules: clear it after editing kernels.
+clean-numba:
+	find src -name '*.nbi' -delete -o -name '*.nbc' -delete

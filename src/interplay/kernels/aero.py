@@ -21,7 +21,7 @@ def centroids(x, tris, out):
             out[t, c] = (x[tris[t, 0], c] + x[tris[t, 1], c] + x[tris[t, 2], c]) / 3.0
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian):
     """Add each triangle's force f/3 (N) to f (n,3) of its points; return the total force.
 

@@ -111,7 +111,7 @@ def ldl_solve(Lp, Li, Lx, dinv, perm, b, z, out):
         out[r, 2] = z[i, 2]
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _local(x, si, sj, pa, pb, l0, kk, tension_only, base, rhs):
     """Local step fused with the right-hand side: rhs = base + sum_s kk_s (+-d_s), d_s the
     spring's vector x_a - x_b projected to its rest length (m); pa, pb the ends' unknown

@@ -78,7 +78,7 @@ def _gather_point(p, x, v, m, alpha, gravity, fext, indptr, ids, sign, fs, a_ptr
     f[p, 2] = f2
 
 
-@njit(cache=True, parallel=True, fastmath=True)
+@njit(cache=True, parallel=True)
 def explicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_pos, a_k, a_c, alpha,
                   gravity, fext, f, h, nsteps, adj):
     """``springs.explicit_step`` (nsteps symplectic-Euler steps of h s) with parallel forces:

@@ -21,7 +21,7 @@ def _spring_vector(x, a, b):
     return d0, d1, d2, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
                    alpha, gravity, fext, f):
     """Total force (N) on each point: springs, anchors, Rayleigh mass damping, gravity, external."""
@@ -326,7 +326,7 @@ def scatter_forces(idx, forces, dfdx, dfdv, vref, fext, kext, dext, kvref, with_
                 kvref[p, a] += kv
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def explicit_step_point_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
                                 a_k, a_c, alpha, gravity, fext, f, h, nsub, centres, velocities,
                                 spins, accels, radii, masses, params, impulses):

@@ -15,7 +15,7 @@ from .contact import sphere_segments
 from .springs import implicit_step, network_forces, symplectic_update
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def substep_with_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k,
                          a_c, alpha, gravity, fext, kext, dext, kvref, f, h, nsub, implicit,
                          theta, bdf2, has_prev, xp, vp, tol, max_iter, seg, centres, velocities, spins, radii, masses,

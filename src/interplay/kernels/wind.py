@@ -18,7 +18,7 @@ from numba import njit
 UNIFORM, SOURCE, VORTEX = 0, 1, 2
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def sample(points, kind, centre, axis, strength, core, out):
     """out[i] = sum over primitives of their velocity (m/s) at points[i] (m)."""
     inv4pi = 1.0 / (4.0 * np.pi)
