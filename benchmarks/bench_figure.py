@@ -15,25 +15,13 @@ Medians of --repeats runs (>= 3) after an untimed warm-up that compiles the Numb
 """
 from __future__ import annotations
 
-import os
+from common import machine, parse_args, stats, write_json  # noqa: I001 (pins threads first)
 
-os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-import argparse  # noqa: E402
-import json  # noqa: E402
-import platform  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
 from dataclasses import replace  # noqa: E402
-from pathlib import Path  # noqa: E402
 
-from interplay.io.atomic import atomic_path  # noqa: E402
 from interplay.scenes import bungee  # noqa: E402
-
-
-def _stats(samples):
-    return {"median": statistics.median(samples), "min": min(samples), "samples": samples}
 
 
 def _params(cord: bool):
@@ -50,7 +38,7 @@ def bench_scene(cord: bool, duration: float, repeats: int) -> dict:
         scene.simulate()
         walls.append(time.perf_counter() - t0)
     med = statistics.median(walls)
-    return {"duration_s": duration, "wall_s": _stats(walls), "sim_s_per_wall_s": duration / med,
+    return {"duration_s": duration, "wall_s": stats(walls), "sim_s_per_wall_s": duration / med,
             "systems": [s.name for s in scene.systems]}
 
 
@@ -64,7 +52,7 @@ def bench_figure_advance(duration: float, repeats: int) -> dict:
             fig.advance(fig.dt)
         walls.append(time.perf_counter() - t0)
     med = statistics.median(walls)
-    return {"duration_s": duration, "wall_s": _stats(walls), "sim_s_per_wall_s": duration / med,
+    return {"duration_s": duration, "wall_s": stats(walls), "sim_s_per_wall_s": duration / med,
             "us_per_step": 1e6 * med / n}
 
 
@@ -78,32 +66,21 @@ def bench_mujoco_only(duration: float, repeats: int) -> dict:
         mujoco.mj_step(fig.model, fig.data, nstep=n)
         walls.append(time.perf_counter() - t0)
     med = statistics.median(walls)
-    return {"duration_s": duration, "wall_s": _stats(walls), "sim_s_per_wall_s": duration / med,
+    return {"duration_s": duration, "wall_s": stats(walls), "sim_s_per_wall_s": duration / med,
             "us_per_step": 1e6 * med / n}
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/bench")
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--quick", action="store_true", help="1 repeat, short runs (smoke check)")
-    a = ap.parse_args()
-    repeats = 1 if a.quick else max(3, a.repeats)
+    a, repeats = parse_args(__doc__)
     import mujoco
-    result = {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                          "platform": platform.platform(), "mujoco": mujoco.__version__,
-                          "numba_threading_layer": os.environ["NUMBA_THREADING_LAYER"],
-                          "load_average_before": list(os.getloadavg())},
+    result = {"machine": machine(mujoco=mujoco.__version__),
               "repeats": repeats,
               "figure": bench_scene(False, 1.0 if a.quick else 3.0, repeats),
               "figure_advance": bench_figure_advance(1.0 if a.quick else 3.0, repeats),
               "mujoco_only": bench_mujoco_only(1.0 if a.quick else 3.0, repeats),
               "bungee": bench_scene(True, 2.0 if a.quick else 8.0, repeats)}
     result["targets"] = {"figure": 20.0, "bungee": 1.0}
-    out = Path(a.out) / "bench_figure.json"
-    result["machine"]["load_average_after"] = list(os.getloadavg())
-    with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(result, indent=2))
+    out = write_json(a.out, "bench_figure.json", result)
     for key, label in (("figure", "figure alone with its controller"),
                        ("figure_advance", "  the same, Figure.advance only"),
                        ("mujoco_only", "MuJoCo mj_step only (no control)"),

@@ -14,28 +14,16 @@ time.
 """
 from __future__ import annotations
 
-import os
+from common import machine, parse_args, stats, write_json  # noqa: I001 (pins threads first)
 
-os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-import argparse  # noqa: E402
-import json  # noqa: E402
-import platform  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
 from interplay.geometry.basin import BasinParams, basin  # noqa: E402
-from interplay.io.atomic import atomic_path  # noqa: E402
 from interplay.scenes import pond  # noqa: E402
 from interplay.systems.water import Water, WaterParams  # noqa: E402
-
-
-def _stats(samples):
-    return {"median": statistics.median(samples), "min": min(samples), "samples": samples}
 
 
 def bench_pond(repeats, duration):
@@ -49,7 +37,7 @@ def bench_pond(repeats, duration):
     d = last.diagnostics()["water"]
     med = statistics.median(walls)
     return {"grid": list(scene.systems[0].shape), "balls": pond.PARAMS().balls.count,
-            "duration_s": duration, "wall_s": _stats(walls),
+            "duration_s": duration, "wall_s": stats(walls),
             "sim_s_per_wall_s": duration / med, "peak_particles": d["peak_particles"],
             "volume_drift_rel": d["volume_drift_rel"], "steps": last.passes[0].steps}
 
@@ -77,7 +65,7 @@ def bench_scaling(sizes, repeats, steps):
             wall = time.perf_counter() - t0
             subs = steps * max(1, int(np.ceil(2e-3 / min(w.dt, 2e-3) - 1e-9)))
             per_sub.append(wall / subs)
-        rows.append({"columns": n * n, "grid": [n, n], "s_per_substep": _stats(per_sub),
+        rows.append({"columns": n * n, "grid": [n, n], "s_per_substep": stats(per_sub),
                      "dt_s": w.dt})
     x = np.log([r["columns"] for r in rows])
     y = np.log([r["s_per_substep"]["median"] for r in rows])
@@ -86,20 +74,12 @@ def bench_scaling(sizes, repeats, steps):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/bench")
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--quick", action="store_true", help="1 repeat, short runs (smoke check)")
-    a = ap.parse_args()
-    repeats = 1 if a.quick else max(3, a.repeats)
-    result = {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                          "numba_threading_layer": os.environ["NUMBA_THREADING_LAYER"]},
+    a, repeats = parse_args(__doc__)
+    result = {"machine": machine(),
               "repeats": repeats,
               "pond": bench_pond(repeats, 0.5 if a.quick else 3.0),
               "scaling": bench_scaling([64, 128, 256, 512], repeats, 5 if a.quick else 50)}
-    out = Path(a.out) / "bench_water.json"
-    with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(result, indent=2))
+    out = write_json(a.out, "bench_water.json", result)
     p = result["pond"]
     print(f"pond {p['grid'][0]}x{p['grid'][1]}, {p['balls']} balls, spray: "
           f"{p['sim_s_per_wall_s']:.2f} simulated s per wall s (median of {repeats}); peak "

@@ -1,0 +1,49 @@
+"""What every benchmark script shares: its command line, timing statistics, the machine it ran
+on, and an atomic JSON write. Import it first: it pins the thread settings (DESIGN.md)."""
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import platform  # noqa: E402
+import statistics  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from interplay.io.atomic import atomic_path  # noqa: E402
+
+
+def parse_args(doc: str):
+    """--out DIR, --repeats N (at least 3) and --quick (1 repeat, short runs); returns
+    (args, repeats)."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--out", default="out/bench")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="1 repeat, short runs (smoke check)")
+    a = ap.parse_args()
+    return a, 1 if a.quick else max(3, a.repeats)
+
+
+def stats(samples) -> dict:
+    """Median, min and every sample (s)."""
+    return {"median": statistics.median(samples), "min": min(samples), "samples": samples}
+
+
+def machine(**extra) -> dict:
+    """CPU count, Python, platform, thread settings and load average, plus ``extra``."""
+    return {"cpus": os.cpu_count(), "python": platform.python_version(),
+            "platform": platform.platform(),
+            "numba_threading_layer": os.environ["NUMBA_THREADING_LAYER"],
+            "load_average_before": list(os.getloadavg()), **extra}
+
+
+def write_json(out_dir, name: str, result: dict) -> Path:
+    """Write ``result`` to out_dir/name atomically (temp file, then rename); returns the path."""
+    result.setdefault("machine", {})["load_average_after"] = list(os.getloadavg())
+    out = Path(out_dir) / name
+    with atomic_path(out) as tmp:
+        tmp.write_text(json.dumps(result, indent=2))
+    return out
