@@ -212,17 +212,201 @@ def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
 
 
 @njit(cache=True)
-def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k, a_c,
-                      alpha, beta, gravity, fext, h, nsteps, iters, rho,
-                      Lp, Li, Lx, dinv, perm,
-                      centres, velocities, accels, radii, params, impulses):
-    """nsteps local/global steps of h seconds with fext (N) held, ``iters`` iterations each.
+def _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g):
+    """Backward Euler's objective Phi (J s^2, up to a constant) at x and its gradient g over the
+    unknowns (N s^2), in the form whose Hessian approximation is the factored matrix A:
+    Phi = 1/2 x.D x - base.x + sum_s [w k/2 |d|^2 - h^2 k l0 |d|], d = x_a - x_b, D the diagonal
+    part of A; g = A x - rhs(x), the local step's residual. A slack tension-only cord
+    contributes w k/2 |d|^2 - h^2 k/2 |d|^2 (only its damping). ``base`` holds the known
+    positions of fixed neighbours (w k x_b, as the global solve needs them), which the spring
+    term's gradient w k d already includes: they are added back here."""
+    phi = 0.0
+    for i in range(x.shape[0]):
+        p = fid[i]
+        if p < 0:
+            continue
+        for r in range(3):
+            g[p, r] = diag[p] * x[i, r] - base[p, r]
+            phi += 0.5 * diag[p] * x[i, r] * x[i, r] - base[p, r] * x[i, r]
+    for s in range(si.shape[0]):
+        a = si[s]
+        b = sj[s]
+        pa = fid[a]
+        pb = fid[b]
+        d0 = x[a, 0] - x[b, 0]
+        d1 = x[a, 1] - x[b, 1]
+        d2 = x[a, 2] - x[b, 2]
+        dd = d0 * d0 + d1 * d1 + d2 * d2
+        ln = np.sqrt(dd)
+        if tension_only[s] and ln < l0[s]:
+            phi += 0.5 * (w - hh) * k[s] * dd
+            sc = (w - hh) * k[s]
+        else:
+            phi += 0.5 * w * k[s] * dd - hh * k[s] * l0[s] * ln
+            sc = w * k[s] - (hh * k[s] * l0[s] / ln if ln > 0.0 else 0.0)
+        f0 = sc * d0
+        f1 = sc * d1
+        f2 = sc * d2
+        if pa >= 0:
+            g[pa, 0] += f0
+            g[pa, 1] += f1
+            g[pa, 2] += f2
+            if pb < 0:  # fixed neighbour: its w k x_b is both in base and in w k d
+                g[pa, 0] += w * k[s] * x[b, 0]
+                g[pa, 1] += w * k[s] * x[b, 1]
+                g[pa, 2] += w * k[s] * x[b, 2]
+                phi += w * k[s] * (x[b, 0] * x[a, 0] + x[b, 1] * x[a, 1] + x[b, 2] * x[a, 2])
+        if pb >= 0:
+            g[pb, 0] -= f0
+            g[pb, 1] -= f1
+            g[pb, 2] -= f2
+            if pa < 0:
+                g[pb, 0] += w * k[s] * x[a, 0]
+                g[pb, 1] += w * k[s] * x[a, 1]
+                g[pb, 2] += w * k[s] * x[a, 2]
+                phi += w * k[s] * (x[a, 0] * x[b, 0] + x[a, 1] * x[b, 1] + x[a, 2] * x[b, 2])
+    return phi
 
-    fid: each point's index among the unknowns, -1 for fixed points; rho: the Chebyshev
-    estimate of the plain iteration's convergence rate (0 for plain iterations). Spheres (k):
-    centres, velocities, accels (k,3) move along c0 + v t + a t^2/2 over the nsteps; radii (k,);
-    params (k,6) as for the network's moving spheres (thickness and mu are used: the contact is
-    a projection); impulses (k,7) receives impulse, angular impulse and peak force (N).
+
+@njit(cache=True)
+def _dot(a, b):
+    s = 0.0
+    for p in range(a.shape[0]):
+        s += a[p, 0] * b[p, 0] + a[p, 1] * b[p, 1] + a[p, 2] * b[p, 2]
+    return s
+
+
+@njit(cache=True)
+def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
+           Lp, Li, Lx, dinv, perm, S, Y, rho, g, gn, q, z, xt, phis):
+    """Minimize Phi by L-BFGS with the factored A as the initial Hessian (Liu, Bouaziz & Kavan
+    2017) and a backtracking Armijo line search; S, Y (mem, nf, 3) hold the last position and
+    gradient changes. Stops after ``iters`` iterations or when an iteration moves no point by
+    more than tol times the first iteration's largest move. Returns the iterations taken;
+    phis[0], phis[1] receive Phi at the first guess and at the end."""
+    mem = S.shape[0]
+    nf = g.shape[0]
+    alpha = np.empty(mem)
+    phi = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g)
+    phis[0] = phi
+    phis[1] = phi
+    for i in range(x.shape[0]):  # the trial point's fixed points
+        for r in range(3):
+            xt[i, r] = x[i, r]
+    stored = 0
+    first = 0.0
+    for it in range(iters):
+        # two-loop recursion: q = H g, H the L-BFGS inverse Hessian on top of A^-1
+        for p in range(nf):
+            for r in range(3):
+                q[p, r] = g[p, r]
+        for j in range(stored - 1, max(0, stored - mem) - 1, -1):
+            c = j % mem
+            alpha[c] = rho[c] * _dot(S[c], q)
+            for p in range(nf):
+                for r in range(3):
+                    q[p, r] -= alpha[c] * Y[c, p, r]
+        ldl_solve(Lp, Li, Lx, dinv, perm, q, z, q)
+        for j in range(max(0, stored - mem), stored):
+            c = j % mem
+            beta = rho[c] * _dot(Y[c], q)
+            for p in range(nf):
+                for r in range(3):
+                    q[p, r] += S[c, p, r] * (alpha[c] - beta)
+        slope = -_dot(g, q)
+        if slope >= 0.0:  # not a descent direction (round-off near the minimum): done
+            return it
+        t = 1.0
+        for _ in range(12):
+            for i in range(x.shape[0]):
+                p = fid[i]
+                if p >= 0:
+                    for r in range(3):
+                        xt[i, r] = x[i, r] - t * q[p, r]
+            phin = _energy_gradient(xt, fid, si, sj, l0, k, tension_only, diag, base, w, hh,
+                                    gn)
+            # Armijo, with room for round-off in Phi's large constant parts
+            if phin <= phi + 1e-4 * t * slope + 1e-13 * abs(phi):
+                break
+            t *= 0.5
+        sy = 0.0
+        move = 0.0
+        for i in range(x.shape[0]):
+            p = fid[i]
+            if p >= 0:
+                for r in range(3):
+                    d = xt[i, r] - x[i, r]
+                    sy += d * (gn[p, r] - g[p, r])
+                    move = max(move, abs(d))
+        # keep only pairs with positive curvature (Phi is not convex where springs are
+        # compressed): H stays positive definite
+        keep = sy > 0.0
+        c = stored % mem
+        for i in range(x.shape[0]):
+            p = fid[i]
+            if p >= 0:
+                for r in range(3):
+                    if keep:
+                        S[c, p, r] = xt[i, r] - x[i, r]
+                        Y[c, p, r] = gn[p, r] - g[p, r]
+                    x[i, r] = xt[i, r]
+                    g[p, r] = gn[p, r]
+        phi = phin
+        phis[1] = phi
+        if keep:
+            rho[c] = 1.0 / sy
+            stored += 1
+        if it == 0:
+            first = move
+        elif move <= tol * first:
+            return it + 1
+    return iters
+
+
+@njit(cache=True)
+def _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs, z, sol,
+               iters, rho, Lp, Li, Lx, dinv, perm):
+    """``iters`` plain local/global iterations, Chebyshev-accelerated (Wang 2015):
+    x_k+1 = x_k-1 + omega (xhat - x_k-1), omega from rho, the estimated convergence rate of the
+    plain iteration; omega = 1 (the first iteration, or rho = 0) is the plain update."""
+    omega = 1.0
+    for i in range(x.shape[0]):
+        for r in range(3):
+            xprev[i, r] = x[i, r]
+    for it in range(iters):
+        _local(x, si, sj, spa, spb, l0, kk, tension_only, base, rhs)
+        ldl_solve(Lp, Li, Lx, dinv, perm, rhs, z, sol)
+        if it == 1:
+            omega = 2.0 / (2.0 - rho * rho)
+        elif it > 1:
+            omega = 4.0 / (4.0 - rho * rho * omega)
+        for i in range(x.shape[0]):
+            p = fid[i]
+            if p >= 0:
+                for r in range(3):
+                    xh = sol[p, r]
+                    xo = xprev[i, r]
+                    xprev[i, r] = x[i, r]
+                    x[i, r] = omega * (xh - xo) + xo
+
+
+@njit(cache=True)
+def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k, a_c,
+                      alpha, beta, gravity, fext, h, nsteps, iters, rho, memory, tol,
+                      Lp, Li, Lx, dinv, perm,
+                      centres, velocities, accels, radii, params, impulses, phis):
+    """nsteps backward-Euler steps of h seconds with fext (N) held; returns the iterations
+    taken in all.
+
+    fid: each point's index among the unknowns, -1 for fixed points. memory > 0: L-BFGS with
+    that many pairs (at most ``iters`` iterations a step, stopping early when an iteration
+    moves no point by more than tol times the first one did); memory = 0: ``iters`` local/global iterations, Chebyshev-accelerated
+    with rho, the estimated convergence rate of the plain iteration (0 for plain iterations).
+    Spheres (k): centres, velocities, accels (k,3) move along c0 + v t + a t^2/2 over the
+    nsteps; radii (k,); params (k,6) as for the network's moving spheres (thickness and mu are
+    used: the contact is a projection); impulses (k,7) receives impulse, angular impulse and
+    peak force (N). phis (2,) receives backward Euler's objective (J s^2, up to a constant) at
+    the last step's first guess and at its end, before any sphere: how far the iterations got.
     """
     n = x.shape[0]
     nf = Lp.shape[0] - 1
@@ -230,11 +414,23 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     hh = h * h
     w = hh + h * beta
     xn = np.empty_like(x)
-    xprev = x.copy()
+    xprev = np.empty_like(x)
     base = np.empty((nf, 3))
     rhs = np.empty((nf, 3))
     z = np.empty((nf, 3))
     sol = np.empty((nf, 3))
+    dirn = np.empty((nf, 3))
+    mem = max(memory, 1)
+    S = np.empty((mem, nf, 3))
+    Y = np.empty((mem, nf, 3))
+    rhos = np.empty(mem)
+    diag = np.zeros(nf)
+    for i in range(n):
+        if fid[i] >= 0:
+            diag[fid[i]] = m[i] * (1.0 + h * alpha)
+    for q in range(a_idx.shape[0]):
+        if fid[a_idx[q]] >= 0:
+            diag[fid[a_idx[q]]] += hh * a_k[q] + h * a_c[q]
     spa = fid[si]
     spb = fid[sj]
     kk = hh * k
@@ -242,6 +438,7 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     vc = np.empty(3)
     imp = np.zeros(6)
     fixed = fid < 0
+    total = 0
     for q in range(impulses.shape[0]):
         for r in range(7):
             impulses[q, r] = 0.0
@@ -275,25 +472,20 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
                     base[pa, r] += lx + (w * k[s] * x[b, r] if pb < 0 else 0.0)
                 if pb >= 0:
                     base[pb, r] += -lx + (w * k[s] * x[a, r] if pa < 0 else 0.0)
-        omega = 1.0
-        for it in range(iters):
-            _local(x, si, sj, spa, spb, l0, kk, tension_only, base, rhs)
-            ldl_solve(Lp, Li, Lx, dinv, perm, rhs, z, sol)
-            # Chebyshev semi-iterative acceleration (Wang 2015): x_k+1 = x_k-1 + omega (xhat -
-            # x_k-1), omega from rho, the estimated convergence rate of the plain iteration;
-            # omega = 1 (the first iteration, or rho = 0) is the plain local/global update
-            if it == 1:
-                omega = 2.0 / (2.0 - rho * rho)
-            elif it > 1:
-                omega = 4.0 / (4.0 - rho * rho * omega)
-            for i in range(n):
-                p = fid[i]
-                if p >= 0:
-                    for r in range(3):
-                        xh = sol[p, r]
-                        xo = xprev[i, r]
-                        xprev[i, r] = x[i, r]
-                        x[i, r] = omega * (xh - xo) + xo
+        if memory > 0:
+            total += _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
+                            Lp, Li, Lx, dinv, perm, S, Y, rhos, rhs, sol, dirn, z, xprev, phis)
+        else:
+            last = step == nsteps - 1
+            if last:
+                phis[0] = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w,
+                                           hh, rhs)
+            _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs, z, sol,
+                       iters, rho, Lp, Li, Lx, dinv, perm)
+            if last:
+                phis[1] = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w,
+                                           hh, rhs)
+            total += iters
         for i in range(n):
             if fid[i] >= 0:
                 for r in range(3):
@@ -311,3 +503,4 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
                 impulses[q, r] += imp[r]
             if jm / h > impulses[q, 6]:
                 impulses[q, 6] = jm / h
+    return total

@@ -78,7 +78,8 @@ class SpringNetwork(System):
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
-                 scheme="theta", theta=1.0, lg_iterations=10, lg_rho=0.95, parallel=None):
+                 scheme="theta", theta=1.0, lg_iterations=10, lg_rho=0.95, lg_memory=5, lg_tolerance=1e-4,
+                 parallel=None):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -138,6 +139,10 @@ class SpringNetwork(System):
         self.cg_iterations = 0
         self.lg_iterations = int(require_positive(name, "lg_iterations", lg_iterations))
         self.lg_rho = float(lg_rho)
+        self.lg_memory = int(require_nonnegative(name, "lg_memory", lg_memory))
+        self.lg_tolerance = require_nonnegative(name, "lg_tolerance", lg_tolerance)
+        self.lg_taken = 0  # iterations taken in the last advance
+        self.lg_objective = np.zeros(2)  # the last step's objective at its first guess and end
         self._lg = None  # the factored local/global matrix and what it was built from
         self.lg_factorizations = 0
         if parallel is None:
@@ -303,12 +308,12 @@ class SpringNetwork(System):
         """n local/global steps of h/n with the held forces and any moving spheres."""
         arr = self._sphere_arrays()
         fid, *lu = self._factors(h / n)
-        LG.localglobal_steps(self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k,
+        self.lg_taken = LG.localglobal_steps(self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k,
                              self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
                              self.alpha,
                              self.beta, self.gravity, self.fext, h / n, n, self.lg_iterations,
-                             self.lg_rho, *lu, arr[0], arr[1], arr[3], arr[4], arr[6],
-                             self.impulses)
+                             self.lg_rho, self.lg_memory, self.lg_tolerance, *lu, arr[0],
+                             arr[1], arr[3], arr[4], arr[6], self.impulses, self.lg_objective)
 
     def _explicit(self, h, n):
         """n symplectic-Euler steps of h s with the held forces, serial or parallel."""
