@@ -1,27 +1,24 @@
-"""Cloth drape benchmark: a 1 m cloth pinned at two corners drapes over a fixed sphere
-(radius 0.25 m) for 2 s, at several resolutions, with our explicit, implicit and local/global
-integrators and MuJoCo's flex on the same scene. Writes JSON (atomically): simulated seconds
-per wall second (median of --runs runs, one run for sizes whose first run took over 20 s),
-each integrator's step, the log-log exponent of cost against vertex count, the parallel
-spring kernel's speed-up, and the machine. A size whose predicted run time exceeds --budget
-seconds is skipped and listed as such. Never a pass/fail timing assert.
+"""Cloth drape benchmark: a 1 m cloth pinned at two corners drapes over a fixed sphere (radius
+0.25 m) for 2 s, at several resolutions, with our integrators and the peers that install here
+(MuJoCo's flex; NVIDIA Newton on the CPU when `newton` imports) on the same scene.
 
-    NUMBA_THREADING_LAYER=workqueue OPENBLAS_NUM_THREADS=1 \\
-        .venv/bin/python benchmarks/bench_cloth.py --out bench_cloth.json
+Writes DIR/bench_cloth.json atomically: simulated seconds per wall second (median of the
+repeats; one run for sizes whose first run took over 20 s), each solver's step, the log-log
+exponent of cost against vertex count, for local/global the iterations a step and how much of
+backward Euler's objective its steps leave unminimized (`objective_gap`), the parallel spring kernel's
+speed-up, and the machine. A size whose predicted run time exceeds --budget seconds is skipped
+and listed as such. Never a pass/fail timing assert.
+
+    .venv/bin/python benchmarks/bench_cloth.py --out out/bench
+    .venv/bin/python benchmarks/bench_cloth.py --sizes 32 64 128 --solvers localglobal newton
 """
 from __future__ import annotations
 
-import argparse
-import json
-import os
-import platform
-import statistics
-import time
+from common import machine, parse_args, stats, write_json  # noqa: I001 (pins threads first)
 
-import numpy as np
+import time  # noqa: E402
 
-os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+import numpy as np  # noqa: E402
 
 DURATION = 2.0  # s
 RADIUS = 0.25  # m, sphere at the origin
@@ -30,6 +27,8 @@ DENSITY = 0.15  # kg/m^2, cotton
 STRETCH = 200.0  # N, k = ratio / l0: cotton-like (the flags' cotton is 150 N)
 H = 1.0 / 60.0  # s, the coupling step: forces and the sphere are exchanged this often
 CONTACT = (0.005, 2.0e3, 0.01, 0.3, 0.01, 0.0)  # thickness m, N/m, N s/m, mu, m/s, penalty
+PROBES = (0.5, 1.0, 1.5, 2.0)  # s: local/global steps compared with converged ones here
+CONVERGED = dict(lg_iterations=3000, lg_memory=10, lg_tolerance=1e-9)
 
 
 def cloth(n, integrator, dt, **kw):
@@ -44,40 +43,73 @@ def cloth(n, integrator, dt, **kw):
                                    **kw)
 
 
-def ours(n, integrator, iterations=10):
-    """(simulated s per wall s, dt, lowest z) for our network. The sphere is collided inside the
-    network's kernel at every substep: with the points for explicit (penalty; the segment test
-    over all ~5 n^2 springs was 70 % of the explicit run at 32^2) and local/global
-    (projection), with the segments for implicit (it needs their Jacobians), of which only
-    those that can reach the sphere within the coupling step are passed (a broad phase per
-    1/60 s in NumPy)."""
-    if integrator == "explicit":
-        dt = 0.9 * cloth(n, "implicit", 1.0).stable_step()
-    else:
-        dt = {"implicit": 1.0 / 240.0, "localglobal": H}[integrator]
-    net = cloth(n, integrator, dt, cg_tolerance=1e-5, lg_iterations=iterations)
-    seg = net.segments()
-    zero = np.zeros(3)
-    t0 = time.perf_counter()
-    for _ in range(int(round(DURATION / H))):
-        net.clear_forces()
-        # a point within reach of the sphere after this step is now within reach + 2 |v|max h
-        # + 1 cm (the doubling covers the speed gained in the step); both ends farther: skip
+def drape_step(net, seg):
+    """One coupling step against the sphere. Explicit and local/global collide the points;
+    implicit needs segments (their Jacobians), of which only those that can reach the sphere
+    within the step are passed (a point within reach after the step is now within reach +
+    2 |v|max h + 1 cm; both ends farther: skip)."""
+    net.clear_forces()
+    sel = None
+    if net.integrator == "implicit":
         r = np.linalg.norm(net.x, axis=1)
         reach = RADIUS + CONTACT[0] + 2.0 * H * float(np.abs(net.v).max()) * np.sqrt(3) + 0.01
         near = r < reach
         sel = seg[near[seg[:, 0]] | near[seg[:, 1]]]
-        net.add_moving_sphere(None if integrator == "explicit" else sel, zero, zero, zero, zero,
-                              RADIUS, 1e9, CONTACT)
-        net.advance(H)
-    wall = time.perf_counter() - t0
+    zero = np.zeros(3)
+    net.add_moving_sphere(sel, zero, zero, zero, zero, RADIUS, 1e9, CONTACT)
+    net.advance(H)
+
+
+def step_gap(net, seg):
+    """How much of backward Euler's objective one local/global step with the network's
+    settings leaves unminimized: (Phi - Phi*) / (Phi0 - Phi*), Phi0 at the first guess and
+    Phi* after a converged step (0 = converged, 1 = no progress); the state is left as it was.
+    Objective rather than positions: positions differ most along near-flat folding modes,
+    which cost almost no energy and which a converged solve may settle either way."""
+    saved = net.x.copy(), net.v.copy(), net.time
+    settings = {k: getattr(net, k) for k in CONVERGED}
+    for k, v in CONVERGED.items():
+        setattr(net, k, v)
+    drape_step(net, seg)
+    phi_best = net.lg_objective[1]
+    for k, v in settings.items():
+        setattr(net, k, v)
+    net.x[:], net.v[:], net.time = saved[0], saved[1], saved[2]
+    drape_step(net, seg)
+    phi0, phi = net.lg_objective
+    net.x[:], net.v[:], net.time = saved[0], saved[1], saved[2]
+    return float((phi - phi_best) / (phi0 - phi_best))
+
+
+def ours(n, integrator, probe=False, **kw):
+    """Our network on the drape; the probes (local/global only) are not timed."""
+    if integrator == "explicit":
+        dt = 0.9 * cloth(n, "implicit", 1.0).stable_step()
+    else:
+        dt = {"implicit": 1.0 / 240.0, "localglobal": H}[integrator]
+    net = cloth(n, integrator, dt, cg_tolerance=1e-5, **kw)
+    seg = net.segments()
+    steps, errors, taken, wall = int(round(DURATION / H)), [], 0, 0.0
+    probe_at = {int(round(t / H)) - 1 for t in PROBES} if probe else set()
+    for i in range(steps):
+        if i in probe_at:
+            errors.append(step_gap(net, seg))
+        t0 = time.perf_counter()
+        drape_step(net, seg)
+        wall += time.perf_counter() - t0
+        taken += getattr(net, "lg_taken", 0)
     if not np.all(np.isfinite(net.x)):
         raise RuntimeError(f"ours {integrator} {n}^2 went non-finite")
-    return DURATION / wall, dt, float(net.x[:, 2].min()), wall
+    row = {"wall_s": wall, "dt_s": dt, "lowest_z_m": float(net.x[:, 2].min())}
+    if integrator == "localglobal":
+        row["iterations_per_step"] = taken / steps
+    if errors:
+        row["objective_gap"] = errors
+    return row
 
 
 def mujoco_flex(n, dt=2e-3):
-    """(simulated s per wall s, dt, lowest z) for MuJoCo's 2D flex grid on the same scene."""
+    """MuJoCo's 2D flex grid on the same scene (implicitfast, its default contact)."""
     import mujoco
     sp = 1.0 / (n - 1)
     xml = f"""<mujoco><option timestep="{dt}" integrator="implicitfast"/>
@@ -89,12 +121,27 @@ def mujoco_flex(n, dt=2e-3):
     </flexcomp></worldbody></mujoco>"""
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
-    steps = int(round(DURATION / dt))
     t0 = time.perf_counter()
-    for _ in range(steps):
+    for _ in range(int(round(DURATION / dt))):
         mujoco.mj_step(m, d)
-    wall = time.perf_counter() - t0
-    return DURATION / wall, dt, float(np.min(d.flexvert_xpos[:, 2])), wall
+    return {"wall_s": time.perf_counter() - t0, "dt_s": dt,
+            "lowest_z_m": float(np.min(d.flexvert_xpos[:, 2]))}
+
+
+def newton_runner():
+    """Newton's cloth on the CPU, or the reason it cannot run here."""
+    try:
+        from peer_newton import available, newton_cloth
+    except ImportError as e:
+        return None, f"not run: {e}"
+    why = available()
+    if why:
+        return None, f"not run: {why}"
+
+    def run(n):
+        rate, dt, lowest, wall = newton_cloth(n, DURATION)
+        return {"wall_s": wall, "dt_s": dt, "lowest_z_m": lowest}
+    return run, None
 
 
 def parallel_speedup(sizes, steps_per_spring=2e6):
@@ -118,87 +165,108 @@ def parallel_speedup(sizes, steps_per_spring=2e6):
     return rows
 
 
-def machine():
+def runners(args):
+    """name -> run(n) -> row, and the peers that could not run, with why."""
+    out, missing = {}, {}
+    for s in args.solvers:
+        if s == "localglobal":
+            for it in args.lg_iterations:
+                out[f"ours-lbfgs-{it}it"] = (
+                    lambda n, it=it: ours(n, "localglobal", True, lg_iterations=it))
+                out[f"ours-chebyshev-{it}it"] = (
+                    lambda n, it=it: ours(n, "localglobal", True, lg_iterations=it,
+                                          lg_memory=0))
+        elif s in ("implicit", "explicit"):
+            out[f"ours-{s}"] = lambda n, s=s: ours(n, s)
+        elif s == "mujoco":
+            out["mujoco-flex"] = mujoco_flex
+        elif s == "newton":
+            run, why = newton_runner()
+            if run is None:
+                missing["newton"] = why
+            else:
+                out["newton"] = run
+    return out, missing
+
+
+def measure(name, fn, sizes, repeats, budget):
+    """Rows for one solver over the sizes, skipping a size predicted to exceed the budget."""
+    rows, walls = [], []
+    for n in sizes:
+        if walls:  # predict from the last growth (or v^1.5 after one size) and skip
+            grow = walls[-1][1] / walls[-2][1] if len(walls) > 1 else 8.0
+            predicted = walls[-1][1] * grow ** np.log2(n / walls[-1][0])
+            if predicted > budget:
+                rows.append({"solver": name, "n": n, "skipped": f"predicted {predicted:.0f} s"
+                             f" a run > budget {budget:.0f} s"})
+                print(f"{name:22s} {n:4d}^2  skipped: predicted {predicted:.0f} s", flush=True)
+                continue
+        try:
+            res = [fn(n)]
+            if res[0]["wall_s"] < 20.0:
+                res += [fn(n) for _ in range(repeats - 1)]
+        except Exception as e:  # a peer that cannot build or blows up is reported as such
+            rows.append({"solver": name, "n": n, "error": str(e)[:200]})
+            print(f"{name:22s} {n:4d}^2  error: {str(e)[:120]}", flush=True)
+            continue
+        wall = stats([r["wall_s"] for r in res])
+        row = {"solver": name, "n": n, "vertices": n * n, **res[0], "wall_s": wall,
+               "realtime_factor": DURATION / wall["median"], "runs": len(res)}
+        walls.append((n, wall["median"]))
+        rows.append(row)
+        err = row.get("objective_gap")
+        print(f"{name:22s} {n:4d}^2  dt={row['dt_s']:.2e} s  {row['realtime_factor']:8.3f}x "
+              f"real time  lowest z {row['lowest_z_m']:+.3f} m"
+              + (f"  objective gap max {max(err):.3f}" if err else "")
+              + f"  ({len(res)} runs)", flush=True)
+    return rows
+
+
+def exponent(rows):
+    """Slope of log(wall) against log(vertices) over the measured sizes."""
+    pts = [(r["vertices"], r["wall_s"]["median"]) for r in rows if "realtime_factor" in r]
+    if len(pts) < 2:
+        return None
+    v, c = np.log(np.array(pts)).T
+    return float(np.polyfit(v, c, 1)[0])
+
+
+def main():
+    def extra(ap):
+        ap.add_argument("--sizes", type=int, nargs="+", default=[32, 64, 128, 256])
+        ap.add_argument("--budget", type=float, default=60.0, help="s a run; larger: skipped")
+        ap.add_argument("--solvers", nargs="+",
+                        default=["localglobal", "implicit", "explicit", "mujoco", "newton"])
+        ap.add_argument("--lg-iterations", type=int, nargs="+", default=[10, 5])
+        ap.add_argument("--no-parallel", action="store_true", help="skip the parallel kernel")
+    args, repeats = parse_args(__doc__, extra)
+    if args.quick:
+        args.sizes = [s for s in args.sizes if s <= 64]
     import numba
     import scipy
-    info = {"platform": platform.platform(), "python": platform.python_version(),
-            "cpus": os.cpu_count(), "numba": numba.__version__, "scipy": scipy.__version__,
-            "numpy": np.__version__, "numba_threads": numba.get_num_threads(),
-            "threading_layer": os.environ.get("NUMBA_THREADING_LAYER"),
-            "loadavg_at_start": os.getloadavg()}
+    info = machine(numpy=np.__version__, scipy=scipy.__version__, numba=numba.__version__,
+                   numba_threads=numba.get_num_threads())
+    for integ in ("explicit", "implicit", "localglobal"):
+        cloth(4, integ, 1e-4).advance(1e-3)  # compile outside the timings
+    solvers, missing = runners(args)
+    rows, slopes = [], {}
+    for name, fn in solvers.items():
+        mine = measure(name, fn, args.sizes, repeats, args.budget)
+        rows += mine
+        slopes[name] = exponent(mine)
     try:
         import mujoco
         info["mujoco"] = mujoco.__version__
     except ImportError:
         info["mujoco"] = None
-    return info
-
-
-def main():
-    from interplay.io.atomic import atomic_path
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[32, 64, 128, 256])
-    ap.add_argument("--runs", type=int, default=3)
-    ap.add_argument("--budget", type=float, default=60.0, help="s per run; larger are skipped")
-    ap.add_argument("--solvers", nargs="+",
-                    default=["localglobal", "implicit", "explicit", "mujoco"])
-    ap.add_argument("--lg-iterations", type=int, nargs="+", default=[10, 5])
-    ap.add_argument("--out", default="bench_cloth.json")
-    args = ap.parse_args()
-    info = machine()
-    for integ in ("explicit", "implicit", "localglobal"):
-        cloth(4, integ, 1e-4).advance(1e-3)  # compile outside the timings
-    runners = {}
-    for s in args.solvers:
-        if s == "localglobal":
-            runners.update({f"ours-localglobal-{i}it": (lambda n, i=i: ours(n, "localglobal", i))
-                            for i in args.lg_iterations})
-        elif s != "mujoco":
-            runners[f"ours-{s}"] = lambda n, s=s: ours(n, s)
-    if "mujoco" in args.solvers:
-        runners["mujoco-flex"] = mujoco_flex
-    rows = []
-    for name, fn in runners.items():
-        walls = []
-        for n in args.sizes:
-            if walls:  # predict from the last growth (or v^1.5 after one size) and skip
-                grow = walls[-1][1] / walls[-2][1] if len(walls) > 1 else 8.0
-                predicted = walls[-1][1] * grow ** np.log2(n / walls[-1][0])
-                if predicted > args.budget:
-                    rows.append({"solver": name, "n": n, "skipped": f"predicted {predicted:.0f} s"
-                                 f" a run > budget {args.budget:.0f} s"})
-                    print(name, n, "skipped: predicted", round(predicted), "s", flush=True)
-                    continue
-            try:
-                res = [fn(n)]
-                if res[0][3] < 20.0:
-                    res += [fn(n) for _ in range(args.runs - 1)]
-            except Exception as e:  # a peer that cannot build or blows up is reported as such
-                rows.append({"solver": name, "n": n, "error": str(e)[:200]})
-                print(name, n, "error:", str(e)[:120], flush=True)
-                continue
-            rate = statistics.median(r[0] for r in res)
-            walls.append((n, DURATION / rate))
-            rows.append({"solver": name, "n": n, "vertices": n * n, "dt_s": res[0][1],
-                         "realtime_factor": rate, "runs": len(res), "lowest_z_m": res[0][2]})
-            print(f"{name:18s} {n:4d}^2  dt={res[0][1]:.2e} s  {rate:8.3f}x real time  "
-                  f"lowest z {res[0][2]:+.3f} m  ({len(res)} runs)", flush=True)
-    slopes = {}
-    for name in runners:
-        pts = [(r["vertices"], 1.0 / r["realtime_factor"]) for r in rows
-               if r["solver"] == name and "realtime_factor" in r]
-        if len(pts) >= 2:
-            v, c = np.log(np.array(pts)).T
-            slopes[name] = float(np.polyfit(v, c, 1)[0])
-    par = parallel_speedup([n for n in args.sizes if n <= 256])
-    out = {"duration_s": DURATION, "coupling_step_s": H, "runs": args.runs, "rows": rows,
-           "cost_vs_vertices_loglog_exponent": slopes, "parallel_explicit": par,
-           "machine": info, "loadavg_at_end": os.getloadavg(),
-           "newton": "not run: not installed here, and not attempted in this benchmark"}
-    with atomic_path(args.out) as tmp:
-        with open(tmp, "w") as f:
-            json.dump(out, f, indent=2)
-    print(json.dumps(slopes))
+    result = {"duration_s": DURATION, "coupling_step_s": H, "repeats": repeats,
+              "probes_s": PROBES, "converged_step": CONVERGED, "rows": rows,
+              "cost_vs_vertices_loglog_exponent": slopes, "peers_not_run": missing,
+              "machine": info}
+    if not args.no_parallel:
+        result["parallel_explicit"] = parallel_speedup([n for n in args.sizes if n <= 256])
+    path = write_json(args.out, "bench_cloth.json", result)
+    print("exponents", {k: (round(v, 2) if v else v) for k, v in slopes.items()}, "->", path)
 
 
 if __name__ == "__main__":

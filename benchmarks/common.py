@@ -16,13 +16,15 @@ from pathlib import Path  # noqa: E402
 from interplay.io.atomic import atomic_path  # noqa: E402
 
 
-def parse_args(doc: str):
-    """--out DIR, --repeats N (at least 3) and --quick (1 repeat, short runs); returns
-    (args, repeats)."""
+def parse_args(doc: str, extra=None):
+    """--out DIR, --repeats N (at least 3) and --quick (1 repeat, short runs), plus whatever
+    ``extra(parser)`` adds; returns (args, repeats)."""
     ap = argparse.ArgumentParser(description=doc.splitlines()[0])
     ap.add_argument("--out", default="out/bench")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="1 repeat, short runs (smoke check)")
+    if extra is not None:
+        extra(ap)
     a = ap.parse_args()
     return a, 1 if a.quick else max(3, a.repeats)
 
