@@ -31,8 +31,9 @@ def hang(net, seconds=0.25, h=0.01):
 def test_lu_solve_matches_the_matrix():
     net = cloth("localglobal", 1 / 60)
     h, alpha, beta = 1 / 60, 0.3, 1e-3
-    fid, *lu = LG.factor(net.m, net.fixed, net.si, net.sj, net.k, net.a_idx, net.a_k,
-                         net.a_c, alpha, beta, h)
+    fid, A_lg = LG.system_matrix(net.m, net.fixed, net.si, net.sj, net.k, net.a_idx, net.a_k,
+                                 net.a_c, alpha, beta, h)
+    lu = LG.factor(A_lg)
     n, free = len(net.m), ~net.fixed
     w = (h * h + h * beta) * net.k
     lap = sp.coo_matrix((np.r_[w, w, -w, -w], (np.r_[net.si, net.sj, net.si, net.sj],

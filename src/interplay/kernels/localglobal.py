@@ -33,14 +33,15 @@ from numba import njit
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
+from .multigrid import vcycle
 
-def factor(m, fixed, si, sj, k, a_idx, a_k, a_c, alpha, beta, h):
-    """Factor the global matrix over the free points for step h (s).
+
+def system_matrix(m, fixed, si, sj, k, a_idx, a_k, a_c, alpha, beta, h):
+    """The global matrix for step h over the free points, and each point's index among them.
 
     m (n,) kg, fixed (n,) bool, springs (si, sj) with k (N/m), anchors a_idx with a_k (N/m)
-    and a_c (N s/m), alpha (1/s), beta (s). Returns Numba-ready arrays (free index of each point or -1, then
-    ``ldl_solve``'s Lp, Li, Lx, dinv, perm).
-    """
+    and a_c (N s/m), alpha (1/s), beta (s). Returns (fid (n,), -1 for fixed points; A, scipy
+    CSC, kg)."""
     n = len(m)
     free = ~fixed
     fid = np.full(n, -1, dtype=np.int64)
@@ -50,7 +51,11 @@ def factor(m, fixed, si, sj, k, a_idx, a_k, a_c, alpha, beta, h):
                          (np.r_[si, sj, si, sj], np.r_[si, sj, sj, si])), shape=(n, n)).tocsr()
     diag = m * (1.0 + h * alpha)
     np.add.at(diag, a_idx, h * h * a_k + h * a_c)
-    A = (sp.diags(diag) + Lap).tocsr()[free][:, free].tocsc()
+    return fid, (sp.diags(diag) + Lap).tocsr()[free][:, free].tocsc()
+
+
+def factor(A):
+    """A = P^T L D L^T P for ``ldl_solve``: (Lp, Li, Lx, dinv, perm)."""
     # A is symmetric positive definite: without row pivoting SuperLU's U is D L^T, so only the
     # unit lower factor and the diagonal are kept (half the memory; at 128^2 the factor then
     # fits in cache and a solve takes 2.4 instead of 4.6 ms)
@@ -69,8 +74,28 @@ def factor(m, fixed, si, sj, k, a_idx, a_k, a_c, alpha, beta, h):
     perm = np.empty_like(lu.perm_c)
     perm[lu.perm_c] = np.arange(len(perm))
     # 32-bit row indices: the triangular solves are memory-bound (12 instead of 16 bytes a nonzero)
-    return (fid, L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
+    return (L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
             1.0 / lu.U.diagonal(), perm.astype(np.int64))
+
+
+# what a preconditioner slot holds when the other one is in use (same types: one compilation)
+NO_DIRECT = (np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0), np.zeros(0),
+             np.zeros(0, np.int64))
+NO_MULTIGRID = (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(1, np.int64),
+                np.zeros(0, np.int32), np.zeros(0), np.zeros(1, np.int64),
+                np.zeros(0, np.int32), np.zeros(0), np.zeros(0), np.zeros((0, 0)),
+                np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)))
+
+
+@njit(cache=True)
+def _apply_h0(direct, mg, q, z):
+    """q <- A^-1 q (approximately): one multigrid V-cycle when mg has levels, else the
+    factored solve; z is scratch."""
+    if mg[0].shape[0] > 0:
+        vcycle(*mg, q, z)
+        q[:] = z
+    else:
+        ldl_solve(*direct, q, z, q)
 
 
 @njit(cache=True)
@@ -278,9 +303,9 @@ def _dot(a, b):
 
 @njit(cache=True)
 def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
-           Lp, Li, Lx, dinv, perm, S, Y, rho, g, gn, q, z, xt, phis):
-    """Minimize Phi by L-BFGS with the factored A as the initial Hessian (Liu, Bouaziz & Kavan
-    2017) and a backtracking Armijo line search; S, Y (mem, nf, 3) hold the last position and
+           direct, mg, S, Y, rho, count, g, gn, q, z, xt, phis):
+    """Minimize Phi by L-BFGS with A as the initial Hessian (Liu, Bouaziz & Kavan 2017; its
+    inverse applied by ``_apply_h0``) and a backtracking Armijo line search; S, Y (mem, nf, 3) hold the last position and
     gradient changes. Stops after ``iters`` iterations or when an iteration moves no point by
     more than tol times the first iteration's largest move. Returns the iterations taken;
     phis[0], phis[1] receive Phi at the first guess and at the end."""
@@ -293,7 +318,7 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
     for i in range(x.shape[0]):  # the trial point's fixed points
         for r in range(3):
             xt[i, r] = x[i, r]
-    stored = 0
+    stored = count[0]
     first = 0.0
     for it in range(iters):
         # two-loop recursion: q = H g, H the L-BFGS inverse Hessian on top of A^-1
@@ -306,7 +331,7 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
             for p in range(nf):
                 for r in range(3):
                     q[p, r] -= alpha[c] * Y[c, p, r]
-        ldl_solve(Lp, Li, Lx, dinv, perm, q, z, q)
+        _apply_h0(direct, mg, q, z)
         for j in range(max(0, stored - mem), stored):
             c = j % mem
             beta = rho[c] * _dot(Y[c], q)
@@ -315,6 +340,7 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
                     q[p, r] += S[c, p, r] * (alpha[c] - beta)
         slope = -_dot(g, q)
         if slope >= 0.0:  # not a descent direction (round-off near the minimum): done
+            count[0] = stored
             return it
         t = 1.0
         for _ in range(12):
@@ -359,13 +385,15 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
         if it == 0:
             first = move
         elif move <= tol * first:
+            count[0] = stored
             return it + 1
+    count[0] = stored
     return iters
 
 
 @njit(cache=True)
 def _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs, z, sol,
-               iters, rho, Lp, Li, Lx, dinv, perm):
+               iters, rho, direct):
     """``iters`` plain local/global iterations, Chebyshev-accelerated (Wang 2015):
     x_k+1 = x_k-1 + omega (xhat - x_k-1), omega from rho, the estimated convergence rate of the
     plain iteration; omega = 1 (the first iteration, or rho = 0) is the plain update."""
@@ -375,7 +403,7 @@ def _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs,
             xprev[i, r] = x[i, r]
     for it in range(iters):
         _local(x, si, sj, spa, spb, l0, kk, tension_only, base, rhs)
-        ldl_solve(Lp, Li, Lx, dinv, perm, rhs, z, sol)
+        ldl_solve(*direct, rhs, z, sol)
         if it == 1:
             omega = 2.0 / (2.0 - rho * rho)
         elif it > 1:
@@ -393,15 +421,20 @@ def _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs,
 @njit(cache=True)
 def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k, a_c,
                       alpha, beta, gravity, fext, h, nsteps, iters, rho, memory, tol,
-                      Lp, Li, Lx, dinv, perm,
-                      centres, velocities, accels, radii, params, impulses, phis):
+                      direct, mg, S, Y, rhos, count, centres, velocities, accels, radii, params,
+                      impulses, phis):
     """nsteps backward-Euler steps of h seconds with fext (N) held; returns the iterations
     taken in all.
 
-    fid: each point's index among the unknowns, -1 for fixed points. memory > 0: L-BFGS with
-    that many pairs (at most ``iters`` iterations a step, stopping early when an iteration
-    moves no point by more than tol times the first one did); memory = 0: ``iters`` local/global iterations, Chebyshev-accelerated
-    with rho, the estimated convergence rate of the plain iteration (0 for plain iterations).
+    fid: each point's index among the unknowns, -1 for fixed points; direct: ``factor``'s
+    arrays; mg: a multigrid hierarchy and workspace (``NO_MULTIGRID`` for the direct solve; only
+    L-BFGS can use it). memory > 0: L-BFGS (at most ``iters`` iterations a step, stopping
+    early when an iteration moves no point by more than tol times the first one did) with the
+    pairs S, Y (memory, nf, 3), their 1 / s.y in rhos and count[0] pairs stored so far, kept
+    from step to step and call to call: the objective's Hessian does not depend on the step's
+    right-hand side, so its pairs stay true while the matrix does; memory = 0: ``iters``
+    local/global iterations, Chebyshev-accelerated with rho, the estimated convergence rate of
+    the plain iteration (0 for plain iterations).
     Spheres (k): centres, velocities, accels (k,3) move along c0 + v t + a t^2/2 over the
     nsteps; radii (k,); params (k,6) as for the network's moving spheres (thickness and mu are
     used: the contact is a projection); impulses (k,7) receives impulse, angular impulse and
@@ -409,7 +442,7 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     the last step's first guess and at its end, before any sphere: how far the iterations got.
     """
     n = x.shape[0]
-    nf = Lp.shape[0] - 1
+    nf = int(np.sum(fid >= 0))
     ns = si.shape[0]
     hh = h * h
     w = hh + h * beta
@@ -420,10 +453,6 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     z = np.empty((nf, 3))
     sol = np.empty((nf, 3))
     dirn = np.empty((nf, 3))
-    mem = max(memory, 1)
-    S = np.empty((mem, nf, 3))
-    Y = np.empty((mem, nf, 3))
-    rhos = np.empty(mem)
     diag = np.zeros(nf)
     for i in range(n):
         if fid[i] >= 0:
@@ -474,14 +503,14 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
                     base[pb, r] += -lx + (w * k[s] * x[a, r] if pa < 0 else 0.0)
         if memory > 0:
             total += _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
-                            Lp, Li, Lx, dinv, perm, S, Y, rhos, rhs, sol, dirn, z, xprev, phis)
+                            direct, mg, S, Y, rhos, count, rhs, sol, dirn, z, xprev, phis)
         else:
             last = step == nsteps - 1
             if last:
                 phis[0] = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w,
                                            hh, rhs)
             _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs, z, sol,
-                       iters, rho, Lp, Li, Lx, dinv, perm)
+                       iters, rho, direct)
             if last:
                 phis[1] = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w,
                                            hh, rhs)

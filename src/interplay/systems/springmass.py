@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
 from ..kernels import localglobal as LG
+from ..kernels import multigrid as MG
 from ..kernels import parallel as PAR
 from ..kernels import springs as K
 from ..kernels.subcycle import substep_with_spheres
@@ -23,6 +24,7 @@ from .base import GRAVITY, System
 
 INTEGRATORS = ("explicit", "implicit", "localglobal")
 SCHEMES = ("bdf2", "theta")
+LG_SOLVERS = ("direct", "multigrid")
 
 
 @dataclass(frozen=True)
@@ -65,10 +67,14 @@ class SpringNetwork(System):
     fixed: indices of points that never move; strain_limit: a strain above which the state is
     reported unstable; scheme: the implicit integrator, "bdf2" (second order, little numerical
     damping of resolved motion) or "theta" (theta-method: theta = 1 backward Euler, 1/2
-    trapezoidal); lg_iterations: local/global iterations per step (integrator="localglobal":
-    more iterations converge towards backward Euler, fewer are cheaper and softer); lg_rho: the
-    Chebyshev acceleration's convergence-rate estimate (0 = plain iterations; above ~0.97 the
-    iteration can diverge); parallel:
+    trapezoidal). integrator="localglobal" minimizes backward Euler's objective each step:
+    lg_memory > 0 by L-BFGS with that many pairs (Liu et al. 2017), at most lg_iterations
+    iterations, stopping when an iteration moves no point by more than lg_tolerance times the
+    first one did; lg_memory = 0 by lg_iterations local/global iterations (Liu et al. 2013),
+    Chebyshev-accelerated with lg_rho (0 = plain; above ~0.97 they can diverge). More
+    iterations converge towards backward Euler; fewer are cheaper and softer. lg_solver: the
+    constant matrix's inverse as a sparse factor ("direct", exact, cost superlinear in points)
+    or one multigrid V-cycle ("multigrid", L-BFGS only: linear cost, approximate). parallel:
     explicit spring forces on all threads (per spring, then a per-point gather: equal to the
     serial kernel to round-off); None uses them from ``kernels.parallel.PARALLEL_MIN_SPRINGS``.
     """
@@ -78,8 +84,8 @@ class SpringNetwork(System):
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
-                 scheme="theta", theta=1.0, lg_iterations=10, lg_rho=0.95, lg_memory=5, lg_tolerance=1e-4,
-                 parallel=None):
+                 scheme="theta", theta=1.0, lg_iterations=10, lg_rho=0.95, lg_memory=5,
+                 lg_tolerance=1e-4, lg_solver="direct", parallel=None):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -141,6 +147,10 @@ class SpringNetwork(System):
         self.lg_rho = float(lg_rho)
         self.lg_memory = int(require_nonnegative(name, "lg_memory", lg_memory))
         self.lg_tolerance = require_nonnegative(name, "lg_tolerance", lg_tolerance)
+        if lg_solver not in LG_SOLVERS:
+            raise ParameterError(f"{name}: unknown lg_solver {lg_solver!r}; choose one of "
+                                 f"{', '.join(LG_SOLVERS)}")
+        self.lg_solver = lg_solver
         self.lg_taken = 0  # iterations taken in the last advance
         self.lg_objective = np.zeros(2)  # the last step's objective at its first guess and end
         self._lg = None  # the factored local/global matrix and what it was built from
@@ -292,28 +302,42 @@ class SpringNetwork(System):
         return self._f
 
     def _factors(self, h):
-        """The local/global factorization for step h, rebuilt only when the step, the masses,
-        the damping, the springs, the anchors or the fixed set changed."""
+        """The local/global preconditioner for step h (the factor, or a multigrid hierarchy and
+        its workspace) and the L-BFGS history, rebuilt only when the step, the masses, the
+        damping, the springs, the anchors, the fixed set, the solver or the memory changed."""
         arrays = (self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k, self.a_c)
         lg = self._lg
-        if (lg is None or lg[0] != (h, self.alpha, self.beta)
+        key = (h, self.alpha, self.beta, self.lg_solver, self.lg_memory)
+        if (lg is None or lg[0] != key
                 or not all(np.array_equal(a, b) for a, b in zip(arrays, lg[1]))):
-            fac = LG.factor(self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k,
-                            self.a_c, self.alpha, self.beta, h)
-            self._lg = lg = ((h, self.alpha, self.beta), tuple(a.copy() for a in arrays), fac)
+            fid, A = LG.system_matrix(self.m, self.fixed, self.si, self.sj, self.k, self.a_idx,
+                                      self.a_k, self.a_c, self.alpha, self.beta, h)
+            if self.lg_solver == "multigrid":
+                hier = MG.hierarchy(A)
+                pre = (LG.NO_DIRECT, (*hier, *MG.workspace(hier)))
+            else:
+                pre = (LG.factor(A), LG.NO_MULTIGRID)
+            # L-BFGS pairs (kept across steps while the matrix is unchanged) and their count
+            nf, mem = A.shape[0], max(self.lg_memory, 1)
+            history = (np.zeros((mem, nf, 3)), np.zeros((mem, nf, 3)), np.zeros(mem),
+                       np.zeros(1, np.int64))
+            self._lg = lg = (key, tuple(a.copy() for a in arrays), (fid, *pre, *history))
             self.lg_factorizations += 1
         return lg[2]
 
     def _localglobal(self, h, n):
         """n local/global steps of h/n with the held forces and any moving spheres."""
+        if self.lg_solver == "multigrid" and self.lg_memory == 0:
+            raise ParameterError(f"{self.name}: lg_solver='multigrid' needs L-BFGS (lg_memory "
+                                 "> 0): plain local/global iterations need the exact solve")
         arr = self._sphere_arrays()
-        fid, *lu = self._factors(h / n)
-        self.lg_taken = LG.localglobal_steps(self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k,
-                             self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
-                             self.alpha,
-                             self.beta, self.gravity, self.fext, h / n, n, self.lg_iterations,
-                             self.lg_rho, self.lg_memory, self.lg_tolerance, *lu, arr[0],
-                             arr[1], arr[3], arr[4], arr[6], self.impulses, self.lg_objective)
+        fid, direct, mg, *history = self._factors(h / n)
+        self.lg_taken = LG.localglobal_steps(
+            self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k, self.tension_only,
+            self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha, self.beta, self.gravity,
+            self.fext, h / n, n, self.lg_iterations, self.lg_rho, self.lg_memory,
+            self.lg_tolerance, direct, mg, *history, arr[0], arr[1], arr[3], arr[4], arr[6],
+            self.impulses, self.lg_objective)
 
     def _explicit(self, h, n):
         """n symplectic-Euler steps of h s with the held forces, serial or parallel."""
