@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_THREADING_LAYER ?= workqueue
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: clean-numba demo test test-all bench clean sysdeps browser
+.PHONY: clean-numba demo test test-all bench bench-cloth clean sysdeps browser
 
 # The preview renderer needs Mesa's EGL driver (headless OpenGL on the CPU); the slow browser
 # tests need Chromium. apt runs only when something is missing, and only as root.
@@ -43,6 +43,11 @@ test-all: $(STAMP) browser
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_basketball.py --out out/bench
+
+# the cloth drape against MuJoCo and NVIDIA Newton (installed here: ~480 MB); ~30-60 min
+bench-cloth: $(STAMP)
+	$(BIN)/pip install -q -e '.[peers]'
+	$(BIN)/python benchmarks/bench_cloth.py --out out/bench
 
 clean:
 	rm -rf $(VENV) out .pytest_cache build src/*.egg-info

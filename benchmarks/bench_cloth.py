@@ -21,13 +21,11 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-DURATION = 2.0  # s
-RADIUS = 0.25  # m, sphere at the origin
-HEIGHT = 0.35  # m, the cloth starts flat this high, centred over the sphere
-DENSITY = 0.15  # kg/m^2, cotton
-STRETCH = 200.0  # N, k = ratio / l0: cotton-like (the flags' cotton is 150 N)
-H = 1.0 / 60.0  # s, the coupling step: forces and the sphere are exchanged this often
-CONTACT = (0.005, 2.0e3, 0.01, 0.3, 0.01, 0.0)  # thickness m, N/m, N s/m, mu, m/s, penalty
+from drape import (CONTACT_KD, CONTACT_KE, DENSITY, DURATION, HEIGHT, MU,  # noqa: E402
+                   RADIUS, STRETCH, THICKNESS)
+from drape import FRAME as H  # noqa: E402
+
+CONTACT = (THICKNESS, CONTACT_KE, CONTACT_KD, MU, 0.01, 0.0)  # + eps m/s, constraint off
 PROBES = (0.5, 1.0, 1.5, 2.0)  # s: local/global steps compared with converged ones here
 CONVERGED = dict(lg_iterations=3000, lg_tolerance=1e-9)  # same solver and history
 
