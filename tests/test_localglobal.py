@@ -275,7 +275,7 @@ def test_lbfgs_leaves_less_of_the_objective_than_local_global():
         _, p0, p = step_objective(net, x0, v0, lg_iterations=10, lg_tolerance=0.0, **settings)
         assert p0 == phi0 and p <= p0
         return (p - best) / (phi0 - best)
-    lbfgs = gap(lg_memory=5)
+    lbfgs = gap(lg_memory=3)
     assert lbfgs < 0.5 * gap(lg_memory=0, lg_rho=0.0)
     assert lbfgs < 0.5 * gap(lg_memory=0, lg_rho=0.95)
     assert lbfgs < 0.005

@@ -253,6 +253,33 @@ def _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g):
         for r in range(3):
             g[p, r] = diag[p] * x[i, r] - base[p, r]
             phi += 0.5 * diag[p] * x[i, r] * x[i, r] - base[p, r] * x[i, r]
+    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, w, hh, g)
+
+
+@njit(cache=True)
+def _energy_gradient_along(x0, q, t, x, fid, si, sj, l0, k, tension_only, diag, base, w, hh,
+                           g):
+    """``_energy_gradient`` at x = x0 - t q (q over the unknowns; fixed points stay), which
+    is written to x: the line search's trial point in the same pass."""
+    phi = 0.0
+    for i in range(x.shape[0]):
+        p = fid[i]
+        if p < 0:
+            for r in range(3):
+                x[i, r] = x0[i, r]
+            continue
+        for r in range(3):
+            xi = x0[i, r] - t * q[p, r] if t != 0.0 else x0[i, r]  # q may be unset at t = 0
+            x[i, r] = xi
+            g[p, r] = diag[p] * xi - base[p, r]
+            phi += 0.5 * diag[p] * xi * xi - base[p, r] * xi
+    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, w, hh, g)
+
+
+@njit(cache=True)
+def _spring_terms(x, fid, si, sj, l0, k, tension_only, w, hh, g):
+    """The springs' part of Phi at x, their gradient added to g."""
+    phi = 0.0
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
@@ -294,101 +321,118 @@ def _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g):
 
 
 @njit(cache=True)
-def _dot(a, b):
-    s = 0.0
-    for p in range(a.shape[0]):
-        s += a[p, 0] * b[p, 0] + a[p, 1] * b[p, 1] + a[p, 2] * b[p, 2]
-    return s
+def _axpy_dot(q, a, y, s):
+    """q -= a y, then return s . q, in one pass (s may be None-like: zero rows)."""
+    acc = 0.0
+    for p in range(q.shape[0]):
+        for r in range(3):
+            v = q[p, r] - a * y[p, r]
+            q[p, r] = v
+            acc += s[p, r] * v
+    return acc
 
 
 @njit(cache=True)
 def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
            direct, mg, S, Y, rho, count, g, gn, q, z, xt, phis):
     """Minimize Phi by L-BFGS with A as the initial Hessian (Liu, Bouaziz & Kavan 2017; its
-    inverse applied by ``_apply_h0``) and a backtracking Armijo line search; S, Y (mem, nf, 3) hold the last position and
-    gradient changes. Stops after ``iters`` iterations or when an iteration moves no point by
-    more than tol times the first iteration's largest move. Returns the iterations taken;
-    phis[0], phis[1] receive Phi at the first guess and at the end."""
-    mem = S.shape[0]
-    nf = g.shape[0]
-    alpha = np.empty(mem)
-    phi = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g)
+    inverse applied by ``_apply_h0``) and a backtracking Armijo line search. S, Y (mem + 1,
+    nf, 3) are a ring of position and gradient changes, rho their 1 / s.y, count[0] the pairs
+    stored so far: the last min(count, mem) are live, and the slot after them is where the
+    next pair is written (kept only if its curvature s.y is positive). Stops after ``iters``
+    iterations or when an iteration moves no point by more than tol times the first
+    iteration's largest move. Returns the iterations taken; phis[0], phis[1] receive Phi at
+    the first guess and at the end. Vector passes are fused: this is memory-bound."""
+    slots = S.shape[0]
+    mem = slots - 1
+    alpha = np.empty(slots)
+    cur, trial = x, xt
+    gc, gt = g, gn
+    swapped = False  # cur is xt
+    phi = _energy_gradient_along(x, q, 0.0, trial, fid, si, sj, l0, k, tension_only, diag,
+                                 base, w, hh, gc)
     phis[0] = phi
     phis[1] = phi
-    for i in range(x.shape[0]):  # the trial point's fixed points
-        for r in range(3):
-            xt[i, r] = x[i, r]
     stored = count[0]
     first = 0.0
+    taken = iters
     for it in range(iters):
-        # two-loop recursion: q = H g, H the L-BFGS inverse Hessian on top of A^-1
-        for p in range(nf):
+        # two-loop recursion: r = H g, H the L-BFGS inverse Hessian on top of A^-1
+        live = min(stored, mem)
+        acc = 0.0
+        c = (stored - 1) % slots
+        for p in range(q.shape[0]):  # q = g, and the newest pair's s . g
             for r in range(3):
-                q[p, r] = g[p, r]
-        for j in range(stored - 1, max(0, stored - mem) - 1, -1):
-            c = j % mem
-            alpha[c] = rho[c] * _dot(S[c], q)
-            for p in range(nf):
-                for r in range(3):
-                    q[p, r] -= alpha[c] * Y[c, p, r]
+                q[p, r] = gc[p, r]
+                acc += S[c, p, r] * gc[p, r]
+        for j in range(live):
+            c = (stored - 1 - j) % slots
+            alpha[c] = rho[c] * acc
+            older = (stored - 2 - j) % slots  # the next pair's s . q, fused (unused at the end)
+            acc = _axpy_dot(q, alpha[c], Y[c], S[older] if j + 1 < live else Y[c])
         _apply_h0(direct, mg, q, z)
-        for j in range(max(0, stored - mem), stored):
-            c = j % mem
-            beta = rho[c] * _dot(Y[c], q)
-            for p in range(nf):
-                for r in range(3):
-                    q[p, r] += S[c, p, r] * (alpha[c] - beta)
-        slope = -_dot(g, q)
+        acc = 0.0
+        if live > 0:
+            acc = _dot(Y[(stored - live) % slots], q)
+        for j in range(live):
+            c = (stored - live + j) % slots
+            beta = rho[c] * acc
+            nxt = Y[(c + 1) % slots] if j + 1 < live else gc  # last: the slope's g . r
+            acc = _axpy_dot(q, beta - alpha[c], S[c], nxt)
+        slope = -(acc if live > 0 else _dot(gc, q))
         if slope >= 0.0:  # not a descent direction (round-off near the minimum): done
-            count[0] = stored
-            return it
+            taken = it
+            break
         t = 1.0
         for _ in range(12):
-            for i in range(x.shape[0]):
-                p = fid[i]
-                if p >= 0:
-                    for r in range(3):
-                        xt[i, r] = x[i, r] - t * q[p, r]
-            phin = _energy_gradient(xt, fid, si, sj, l0, k, tension_only, diag, base, w, hh,
-                                    gn)
+            phin = _energy_gradient_along(cur, q, t, trial, fid, si, sj, l0, k, tension_only,
+                                          diag, base, w, hh, gt)
             # Armijo, with room for round-off in Phi's large constant parts
             if phin <= phi + 1e-4 * t * slope + 1e-13 * abs(phi):
                 break
             t *= 0.5
+        # the pair goes to the free slot; it becomes live only with positive curvature (Phi
+        # is not convex where springs are compressed): H stays positive definite
+        c = stored % slots
         sy = 0.0
         move = 0.0
         for i in range(x.shape[0]):
             p = fid[i]
             if p >= 0:
                 for r in range(3):
-                    d = xt[i, r] - x[i, r]
-                    sy += d * (gn[p, r] - g[p, r])
+                    d = trial[i, r] - cur[i, r]
+                    e = gt[p, r] - gc[p, r]
+                    S[c, p, r] = d
+                    Y[c, p, r] = e
+                    sy += d * e
                     move = max(move, abs(d))
-        # keep only pairs with positive curvature (Phi is not convex where springs are
-        # compressed): H stays positive definite
-        keep = sy > 0.0
-        c = stored % mem
-        for i in range(x.shape[0]):
-            p = fid[i]
-            if p >= 0:
-                for r in range(3):
-                    if keep:
-                        S[c, p, r] = xt[i, r] - x[i, r]
-                        Y[c, p, r] = gn[p, r] - g[p, r]
-                    x[i, r] = xt[i, r]
-                    g[p, r] = gn[p, r]
+        cur, trial = trial, cur
+        gc, gt = gt, gc
+        swapped = not swapped
         phi = phin
         phis[1] = phi
-        if keep:
+        if sy > 0.0:
             rho[c] = 1.0 / sy
             stored += 1
         if it == 0:
             first = move
         elif move <= tol * first:
-            count[0] = stored
-            return it + 1
+            taken = it + 1
+            break
     count[0] = stored
-    return iters
+    if swapped:
+        for i in range(x.shape[0]):
+            for r in range(3):
+                x[i, r] = cur[i, r]
+    return taken
+
+
+@njit(cache=True)
+def _dot(a, b):
+    s = 0.0
+    for p in range(a.shape[0]):
+        s += a[p, 0] * b[p, 0] + a[p, 1] * b[p, 1] + a[p, 2] * b[p, 2]
+    return s
 
 
 @njit(cache=True)
@@ -430,7 +474,7 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     arrays; mg: a multigrid hierarchy and workspace (``NO_MULTIGRID`` for the direct solve; only
     L-BFGS can use it). memory > 0: L-BFGS (at most ``iters`` iterations a step, stopping
     early when an iteration moves no point by more than tol times the first one did) with the
-    pairs S, Y (memory, nf, 3), their 1 / s.y in rhos and count[0] pairs stored so far, kept
+    pairs S, Y (memory + 1, nf, 3) (a ring: ``_lbfgs``), their 1 / s.y in rhos and count[0] pairs stored so far, kept
     from step to step and call to call: the objective's Hessian does not depend on the step's
     right-hand side, so its pairs stay true while the matrix does; memory = 0: ``iters``
     local/global iterations, Chebyshev-accelerated with rho, the estimated convergence rate of
