@@ -134,7 +134,7 @@ def newton_runner():
     if why:
         return None, f"not run: {why}"
 
-    def run(n):
+    def run(n, first):
         rate, dt, lowest, wall = newton_cloth(n, DURATION)
         return {"wall_s": wall, "dt_s": dt, "lowest_z_m": lowest}
     return run, None
@@ -162,22 +162,23 @@ def parallel_speedup(sizes, steps_per_spring=2e6):
 
 
 def runners(args):
-    """name -> run(n) -> row, and the peers that could not run, with why."""
+    """name -> run(n, first) -> row (first: the size's first run, which alone is probed),
+    and the peers that could not run, with why."""
     out, missing = {}, {}
     for s in args.solvers:
         if s == "localglobal":
             for it in args.lg_iterations:
                 for sv in args.lg_solvers:
                     out[f"ours-lbfgs-{sv}-{it}it"] = (
-                        lambda n, it=it, sv=sv: ours(n, "localglobal", True, lg_iterations=it,
-                                                     lg_solver=sv))
+                        lambda n, first, it=it, sv=sv: ours(n, "localglobal", first,
+                                                            lg_iterations=it, lg_solver=sv))
                 out[f"ours-chebyshev-{it}it"] = (
-                    lambda n, it=it: ours(n, "localglobal", True, lg_iterations=it,
-                                          lg_memory=0))
+                    lambda n, first, it=it: ours(n, "localglobal", first, lg_iterations=it,
+                                                 lg_memory=0))
         elif s in ("implicit", "explicit"):
-            out[f"ours-{s}"] = lambda n, s=s: ours(n, s)
+            out[f"ours-{s}"] = lambda n, first, s=s: ours(n, s)
         elif s == "mujoco":
-            out["mujoco-flex"] = mujoco_flex
+            out["mujoco-flex"] = lambda n, first: mujoco_flex(n)
         elif s == "newton":
             run, why = newton_runner()
             if run is None:
@@ -200,9 +201,9 @@ def measure(name, fn, sizes, repeats, budget):
                 print(f"{name:22s} {n:4d}^2  skipped: predicted {predicted:.0f} s", flush=True)
                 continue
         try:
-            res = [fn(n)]
+            res = [fn(n, True)]
             if res[0]["wall_s"] < 20.0:
-                res += [fn(n) for _ in range(repeats - 1)]
+                res += [fn(n, False) for _ in range(repeats - 1)]
         except Exception as e:  # a peer that cannot build or blows up is reported as such
             rows.append({"solver": name, "n": n, "error": str(e)[:200]})
             print(f"{name:22s} {n:4d}^2  error: {str(e)[:120]}", flush=True)
@@ -227,6 +228,24 @@ def exponent(rows):
         return None
     v, c = np.log(np.array(pts)).T
     return float(np.polyfit(v, c, 1)[0])
+
+
+def summary(rows, iterations=10):
+    """Per size: our default local/global (L-BFGS, ``iterations`` a step, lg_solver "auto":
+    multigrid from MULTIGRID_MIN_POINTS free points), the fastest peer, and their ratio."""
+    from interplay.systems.springmass import MULTIGRID_MIN_POINTS
+    rate = {(r["solver"], r["n"]): r["realtime_factor"] for r in rows if "realtime_factor" in r}
+    out = []
+    for n in sorted({r["n"] for r in rows}):
+        solver = "multigrid" if n * n - 2 >= MULTIGRID_MIN_POINTS else "direct"
+        mine = rate.get((f"ours-lbfgs-{solver}-{iterations}it", n))
+        peers = {k: v for (k, m), v in rate.items() if m == n and not k.startswith("ours")}
+        best = max(peers, key=peers.get) if peers else None
+        out.append({"n": n, "default": f"ours-lbfgs-{solver}-{iterations}it",
+                    "realtime_factor": mine, "fastest_peer": best,
+                    "peer_realtime_factor": peers.get(best),
+                    "ratio": mine / peers[best] if mine and best else None})
+    return out
 
 
 def main():
@@ -261,10 +280,13 @@ def main():
     result = {"duration_s": DURATION, "coupling_step_s": H, "repeats": repeats,
               "probes_s": PROBES, "converged_step": CONVERGED, "rows": rows,
               "cost_vs_vertices_loglog_exponent": slopes, "peers_not_run": missing,
+              "summary": summary(rows),
               "machine": info}
     if not args.no_parallel:
         result["parallel_explicit"] = parallel_speedup([n for n in args.sizes if n <= 256])
     path = write_json(args.out, "bench_cloth.json", result)
+    for row in result["summary"]:
+        print("summary", row)
     print("exponents", {k: (round(v, 2) if v else v) for k, v in slopes.items()}, "->", path)
 
 
