@@ -230,7 +230,7 @@ def exponent(rows):
     return float(np.polyfit(v, c, 1)[0])
 
 
-def summary(rows, iterations=10):
+def summary(rows, iterations):
     """Per size: our default local/global (L-BFGS, ``iterations`` a step, lg_solver "auto":
     multigrid from MULTIGRID_MIN_POINTS free points), the fastest peer, and their ratio."""
     from interplay.systems.springmass import MULTIGRID_MIN_POINTS
@@ -280,13 +280,14 @@ def main():
     result = {"duration_s": DURATION, "coupling_step_s": H, "repeats": repeats,
               "probes_s": PROBES, "converged_step": CONVERGED, "rows": rows,
               "cost_vs_vertices_loglog_exponent": slopes, "peers_not_run": missing,
-              "summary": summary(rows),
+              "summary": {f"{it}it": summary(rows, it) for it in args.lg_iterations},
               "machine": info}
     if not args.no_parallel:
         result["parallel_explicit"] = parallel_speedup([n for n in args.sizes if n <= 256])
     path = write_json(args.out, "bench_cloth.json", result)
-    for row in result["summary"]:
-        print("summary", row)
+    for key, table in result["summary"].items():
+        for row in table:
+            print("summary", key, row)
     print("exponents", {k: (round(v, 2) if v else v) for k, v in slopes.items()}, "->", path)
 
 

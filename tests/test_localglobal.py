@@ -239,17 +239,21 @@ def crumpled_cloth():
 def test_objective_gradient_matches_its_finite_differences():
     """L-BFGS's line search trusts that the gradient is the objective's: central differences
     with step e agree to O(e^2) (third derivative times e^2, ~1e-9 relative here; asserted
-    1e-6), with fixed points, slack tension-only cords and springs of every kind."""
+    1e-6), with fixed points, slack tension-only cords, springs of every kind, and lagged
+    damping directions."""
     net, x0, _ = crumpled_cloth()
     net.tension_only[:3] = True
     net.l0[:3] *= 2.0  # slack
-    h, w = 1 / 60, (1 / 60) ** 2 + 1 / 60 * 1e-3
     fid = np.where(net.fixed, -1, np.cumsum(~net.fixed) - 1)
     nf = int((~net.fixed).sum())
     rng = np.random.default_rng(2)
     diag, base = rng.uniform(1e-3, 2e-3, nf), rng.normal(size=(nf, 3)) * 1e-3
+    d = net.x[net.si] - net.x[net.sj]  # the start of the step: the flat cloth
+    u = d / np.linalg.norm(d, axis=1)[:, None]
+    cn = np.einsum("ij,ij->i", u, d)
     g = np.empty((nf, 3))
-    args = (fid, net.si, net.sj, net.l0, net.k, net.tension_only, diag, base, w, h * h)
+    args = (fid, net.si, net.sj, net.l0, net.k, net.tension_only, u, cn, diag, base,
+            (1 / 60) ** 2, 1 / 60 * 1e-3)
     LG._energy_gradient(x0, *args, g)
     e = 1e-6
     for p, r in [(0, 0), (3, 0), (17, 2), (nf - 1, 1)]:
@@ -264,9 +268,9 @@ def test_objective_gradient_matches_its_finite_differences():
 
 def test_lbfgs_leaves_less_of_the_objective_than_local_global():
     """At a fixed iteration budget L-BFGS (Liu et al. 2017) leaves a smaller part of the step's
-    backward-Euler objective unminimized than plain and Chebyshev-accelerated local/global
-    (measured at 10 iterations: 1.7e-3 against 4.5e-3 and 5.6e-3; asserted with margin), and
-    its line search makes the step decrease the objective."""
+    backward-Euler objective unminimized than plain local/global iterations (memory 0; Liu et
+    al. 2013) (measured at 10 iterations: 1.7e-3 against 4.5e-3; asserted with margin),
+    and its line search makes the step decrease the objective."""
     net, x0, v0 = crumpled_cloth()
     _, phi0, best = step_objective(net, x0, v0, lg_iterations=3000, lg_memory=10,
                                    lg_tolerance=1e-13)
@@ -276,6 +280,5 @@ def test_lbfgs_leaves_less_of_the_objective_than_local_global():
         assert p0 == phi0 and p <= p0
         return (p - best) / (phi0 - best)
     lbfgs = gap(lg_memory=3)
-    assert lbfgs < 0.5 * gap(lg_memory=0, lg_rho=0.0)
-    assert lbfgs < 0.5 * gap(lg_memory=0, lg_rho=0.95)
+    assert lbfgs < 0.5 * gap(lg_memory=0)
     assert lbfgs < 0.005

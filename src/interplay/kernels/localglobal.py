@@ -1,32 +1,31 @@
-"""Local/global ("fast mass-spring") integration of spring networks (Liu et al. 2013).
+"""Local/global integration of spring networks: backward Euler as a minimization (Liu et al.
+2013), solved by L-BFGS with the constant local/global matrix as its initial Hessian (Liu,
+Bouaziz & Kavan 2017).
 
-Backward Euler for springs is the minimization of
-    1/(2 h^2) |x - y|_M^2 + sum_s k_s/2 (|x_a - x_b| - l0_s)^2,   y = x_n + h v_n + h^2 M^-1 f,
-and each spring term equals min over |d_s| = l0_s of k_s/2 |x_a - x_b - d_s|^2. Alternating
-the *local* step (d_s = the spring's current direction at rest length: a projection per
-spring) with the *global* step (a linear solve for x with d held) decreases that energy
-monotonically, but slowly on stiff fine cloth: a fixed number of plain iterations is not the
-converged step, and undamped cloth then gains energy over seconds (measured in
-tests/test_localglobal.py). The iterations are therefore Chebyshev-accelerated (Wang 2015) with
-an estimated convergence rate rho (0 = plain; 0.95 with 10 iterations kept a 1 m, 200 N,
-16 x 16 cloth's energy falling at 1/60 s; 0.99 with 8 diverged: keep rho <~ 0.97). The global
-matrix A = M (1 + h alpha) + (h^2 + h beta) L + h^2 K_anchor + h C_anchor,
-L = sum_s k_s (e_a - e_b)(e_a - e_b)^T, does not depend on the state: it is factored once
-(scipy's SuperLU as L D L^T, ``factor``) and every iteration is two triangular solves
-(``ldl_solve``).
+A backward-Euler step of h seconds is the minimizer of
+    Phi(x) = 1/2 |x - y|^2_M' - ... = 1/2 x.D x - base.x
+             + sum_s h^2 k_s/2 (|d_s| - l0_s)^2 + h beta k_s/2 (u_s . (d_s - d_s,n))^2,
+d_s = x_a - x_b, y = x_n + h v_n + h^2 M^-1 f, D = M (1 + h alpha) (+ anchors), so that
+grad Phi = 0 is M (x - y) / h^2 = spring forces - alpha M v - along-spring damping. The damping
+is the explicit network's: mass-proportional -alpha m v, and stiffness-proportional beta k
+along each spring, whose direction u_s is taken at the step's start (lagged: the term is then
+quadratic). Slack tension-only cords (shorter than l0) pull nothing; at the step's start they
+also damp nothing.
 
-Damping is implicit and lives in that constant matrix: mass-proportional (-alpha M v) exactly
-as the explicit network has it, and stiffness-proportional as -beta L v (Rayleigh damping on the
-constant spring Laplacian; the explicit network damps only along each spring, so here relative
-transverse motion is damped too). Fixed points are eliminated: only free points are unknowns,
-and springs to fixed points move their known positions to the right-hand side.
+Each spring term equals min over |p_s| = l0_s of k_s/2 |d_s - p_s|^2 (the *local* projection),
+and with p held the objective is quadratic with the constant matrix
+A = M (1 + h alpha) + (h^2 + h beta) L + h^2 K_anchor + h C_anchor,
+L = sum_s k_s (e_a - e_b)(e_a - e_b)^T (the *global* solve): x - A^-1 grad Phi is one plain
+local/global iteration. A bounds the damping's Hessian (u u^T <= I), does not depend on the
+state, and is factored once (``factor``: SuperLU as L D L^T) or given a multigrid hierarchy
+(``multigrid``). L-BFGS builds on A^-1 the curvature the projections leave out, with an Armijo
+line search (the objective never rises). With memory 0 it is plain local/global.
 
-A tension-only cord that is shorter than its rest length projects onto its current vector
-(d_s = x_a - x_b), so it pulls nothing at convergence. External forces (aero, contacts,
-attachments) enter y explicitly; their Jacobians are ignored, so very stiff penalty couplings
-need a small step here (or the explicit/implicit integrators). Moving spheres are handled as a
-position projection (an infinitely stiff contact) after each step with Coulomb friction on the
-velocity; the momentum removed from the network is returned as the sphere's impulse.
+Fixed points are not unknowns. External forces (aero, contacts, attachments) enter y
+explicitly; their Jacobians are ignored, so very stiff penalty couplings need a small step here
+(or the explicit/implicit integrators). Moving spheres are handled as a position projection (an
+infinitely stiff contact) after each step with Coulomb friction on the velocity; the momentum
+removed from the network is returned as the sphere's impulse.
 """
 import numpy as np
 from numba import njit
@@ -137,39 +136,6 @@ def ldl_solve(Lp, Li, Lx, dinv, perm, b, z, out):
 
 
 @njit(cache=True)
-def _local(x, si, sj, pa, pb, l0, kk, tension_only, base, rhs):
-    """Local step fused with the right-hand side: rhs = base + sum_s kk_s (+-d_s), d_s the
-    spring's vector x_a - x_b projected to its rest length (m); pa, pb the ends' unknown
-    indices (-1 fixed), kk = h^2 k (N s^2/m)."""
-    for p in range(rhs.shape[0]):
-        rhs[p, 0] = base[p, 0]
-        rhs[p, 1] = base[p, 1]
-        rhs[p, 2] = base[p, 2]
-    for s in range(si.shape[0]):
-        a = si[s]
-        b = sj[s]
-        d0 = x[a, 0] - x[b, 0]
-        d1 = x[a, 1] - x[b, 1]
-        d2 = x[a, 2] - x[b, 2]
-        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        sc = kk[s]
-        # a slack cord keeps its own vector; a degenerate spring has no direction to keep
-        if ln > 0.0 and not (tension_only[s] and ln < l0[s]):
-            sc *= l0[s] / ln
-        d0 *= sc
-        d1 *= sc
-        d2 *= sc
-        if pa[s] >= 0:
-            rhs[pa[s], 0] += d0
-            rhs[pa[s], 1] += d1
-            rhs[pa[s], 2] += d2
-        if pb[s] >= 0:
-            rhs[pb[s], 0] -= d0
-            rhs[pb[s], 1] -= d1
-            rhs[pb[s], 2] -= d2
-
-
-@njit(cache=True)
 def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
     """Project points inside a sphere (centre c m, velocity vc m/s) out to radius + thickness
     (radially; a point that crossed the centre since the step's start xn goes back out on
@@ -237,14 +203,11 @@ def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
 
 
 @njit(cache=True)
-def _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g):
-    """Backward Euler's objective Phi (J s^2, up to a constant) at x and its gradient g over the
-    unknowns (N s^2), in the form whose Hessian approximation is the factored matrix A:
-    Phi = 1/2 x.D x - base.x + sum_s [w k/2 |d|^2 - h^2 k l0 |d|], d = x_a - x_b, D the diagonal
-    part of A; g = A x - rhs(x), the local step's residual. A slack tension-only cord
-    contributes w k/2 |d|^2 - h^2 k/2 |d|^2 (only its damping). ``base`` holds the known
-    positions of fixed neighbours (w k x_b, as the global solve needs them), which the spring
-    term's gradient w k d already includes: they are added back here."""
+def _energy_gradient(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, g):
+    """Phi (J s^2, up to a constant) at x (all points, fixed ones at their places) and its
+    gradient g over the unknowns (N s^2). u (ns, 3), cn (ns,): each spring's unit direction at
+    the step's start and u . d there (m; a slack or degenerate spring has u = 0); hh = h^2,
+    hb = h beta (s^2)."""
     phi = 0.0
     for i in range(x.shape[0]):
         p = fid[i]
@@ -253,12 +216,12 @@ def _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, g):
         for r in range(3):
             g[p, r] = diag[p] * x[i, r] - base[p, r]
             phi += 0.5 * diag[p] * x[i, r] * x[i, r] - base[p, r] * x[i, r]
-    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, w, hh, g)
+    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, u, cn, hh, hb, g)
 
 
 @njit(cache=True)
-def _energy_gradient_along(x0, q, t, x, fid, si, sj, l0, k, tension_only, diag, base, w, hh,
-                           g):
+def _energy_gradient_along(x0, q, t, x, fid, si, sj, l0, k, tension_only, u, cn, diag, base,
+                           hh, hb, g):
     """``_energy_gradient`` at x = x0 - t q (q over the unknowns; fixed points stay), which
     is written to x: the line search's trial point in the same pass."""
     phi = 0.0
@@ -273,50 +236,43 @@ def _energy_gradient_along(x0, q, t, x, fid, si, sj, l0, k, tension_only, diag, 
             x[i, r] = xi
             g[p, r] = diag[p] * xi - base[p, r]
             phi += 0.5 * diag[p] * xi * xi - base[p, r] * xi
-    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, w, hh, g)
+    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, u, cn, hh, hb, g)
 
 
 @njit(cache=True)
-def _spring_terms(x, fid, si, sj, l0, k, tension_only, w, hh, g):
-    """The springs' part of Phi at x, their gradient added to g."""
+def _spring_terms(x, fid, si, sj, l0, k, tension_only, u, cn, hh, hb, g):
+    """The springs' part of Phi at x (stretch energy and lagged along-spring damping), their
+    gradient added to g."""
     phi = 0.0
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
-        pa = fid[a]
-        pb = fid[b]
         d0 = x[a, 0] - x[b, 0]
         d1 = x[a, 1] - x[b, 1]
         d2 = x[a, 2] - x[b, 2]
-        dd = d0 * d0 + d1 * d1 + d2 * d2
-        ln = np.sqrt(dd)
-        if tension_only[s] and ln < l0[s]:
-            phi += 0.5 * (w - hh) * k[s] * dd
-            sc = (w - hh) * k[s]
-        else:
-            phi += 0.5 * w * k[s] * dd - hh * k[s] * l0[s] * ln
-            sc = w * k[s] - (hh * k[s] * l0[s] / ln if ln > 0.0 else 0.0)
-        f0 = sc * d0
-        f1 = sc * d1
-        f2 = sc * d2
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        e = ln - l0[s]
+        sc = 0.0
+        if ln > 0.0 and not (tension_only[s] and e < 0.0):
+            phi += 0.5 * hh * k[s] * e * e
+            sc = hh * k[s] * e / ln
+        # damping: h beta k (u . d - u . d_n) along the start direction u
+        c = u[s, 0] * d0 + u[s, 1] * d1 + u[s, 2] * d2 - cn[s]
+        phi += 0.5 * hb * k[s] * c * c
+        cd = hb * k[s] * c
+        f0 = sc * d0 + cd * u[s, 0]
+        f1 = sc * d1 + cd * u[s, 1]
+        f2 = sc * d2 + cd * u[s, 2]
+        pa = fid[a]
+        pb = fid[b]
         if pa >= 0:
             g[pa, 0] += f0
             g[pa, 1] += f1
             g[pa, 2] += f2
-            if pb < 0:  # fixed neighbour: its w k x_b is both in base and in w k d
-                g[pa, 0] += w * k[s] * x[b, 0]
-                g[pa, 1] += w * k[s] * x[b, 1]
-                g[pa, 2] += w * k[s] * x[b, 2]
-                phi += w * k[s] * (x[b, 0] * x[a, 0] + x[b, 1] * x[a, 1] + x[b, 2] * x[a, 2])
         if pb >= 0:
             g[pb, 0] -= f0
             g[pb, 1] -= f1
             g[pb, 2] -= f2
-            if pa < 0:
-                g[pb, 0] += w * k[s] * x[a, 0]
-                g[pb, 1] += w * k[s] * x[a, 1]
-                g[pb, 2] += w * k[s] * x[a, 2]
-                phi += w * k[s] * (x[a, 0] * x[b, 0] + x[a, 1] * x[b, 1] + x[a, 2] * x[b, 2])
     return phi
 
 
@@ -333,7 +289,7 @@ def _axpy_dot(q, a, y, s):
 
 
 @njit(cache=True)
-def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
+def _lbfgs(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, iters, tol,
            direct, mg, S, Y, rho, count, g, gn, q, z, xt, phis):
     """Minimize Phi by L-BFGS with A as the initial Hessian (Liu, Bouaziz & Kavan 2017; its
     inverse applied by ``_apply_h0``) and a backtracking Armijo line search. S, Y (mem + 1,
@@ -349,8 +305,8 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
     cur, trial = x, xt
     gc, gt = g, gn
     swapped = False  # cur is xt
-    phi = _energy_gradient_along(x, q, 0.0, trial, fid, si, sj, l0, k, tension_only, diag,
-                                 base, w, hh, gc)
+    phi = _energy_gradient_along(x, q, 0.0, trial, fid, si, sj, l0, k, tension_only, u, cn,
+                                 diag, base, hh, hb, gc)
     phis[0] = phi
     phis[1] = phi
     stored = count[0]
@@ -386,7 +342,7 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
         t = 1.0
         for _ in range(12):
             phin = _energy_gradient_along(cur, q, t, trial, fid, si, sj, l0, k, tension_only,
-                                          diag, base, w, hh, gt)
+                                          u, cn, diag, base, hh, hb, gt)
             # Armijo, with room for round-off in Phi's large constant parts
             if phin <= phi + 1e-4 * t * slope + 1e-13 * abs(phi):
                 break
@@ -436,88 +392,58 @@ def _dot(a, b):
 
 
 @njit(cache=True)
-def _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs, z, sol,
-               iters, rho, direct):
-    """``iters`` plain local/global iterations, Chebyshev-accelerated (Wang 2015):
-    x_k+1 = x_k-1 + omega (xhat - x_k-1), omega from rho, the estimated convergence rate of the
-    plain iteration; omega = 1 (the first iteration, or rho = 0) is the plain update."""
-    omega = 1.0
-    for i in range(x.shape[0]):
-        for r in range(3):
-            xprev[i, r] = x[i, r]
-    for it in range(iters):
-        _local(x, si, sj, spa, spb, l0, kk, tension_only, base, rhs)
-        ldl_solve(*direct, rhs, z, sol)
-        if it == 1:
-            omega = 2.0 / (2.0 - rho * rho)
-        elif it > 1:
-            omega = 4.0 / (4.0 - rho * rho * omega)
-        for i in range(x.shape[0]):
-            p = fid[i]
-            if p >= 0:
-                for r in range(3):
-                    xh = sol[p, r]
-                    xo = xprev[i, r]
-                    xprev[i, r] = x[i, r]
-                    x[i, r] = omega * (xh - xo) + xo
-
-
-@njit(cache=True)
 def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k, a_c,
-                      alpha, beta, gravity, fext, h, nsteps, iters, rho, memory, tol,
+                      alpha, beta, gravity, fext, h, nsteps, iters, tol,
                       direct, mg, S, Y, rhos, count, centres, velocities, accels, radii, params,
                       impulses, phis):
     """nsteps backward-Euler steps of h seconds with fext (N) held; returns the iterations
     taken in all.
 
     fid: each point's index among the unknowns, -1 for fixed points; direct: ``factor``'s
-    arrays; mg: a multigrid hierarchy and workspace (``NO_MULTIGRID`` for the direct solve; only
-    L-BFGS can use it). memory > 0: L-BFGS (at most ``iters`` iterations a step, stopping
+    arrays, or mg: a multigrid hierarchy and workspace (the other one ``NO_DIRECT`` /
+    ``NO_MULTIGRID``). Each step runs ``_lbfgs`` (at most ``iters`` iterations, stopping
     early when an iteration moves no point by more than tol times the first one did) with the
-    pairs S, Y (memory + 1, nf, 3) (a ring: ``_lbfgs``), their 1 / s.y in rhos and count[0] pairs stored so far, kept
-    from step to step and call to call: the objective's Hessian does not depend on the step's
-    right-hand side, so its pairs stay true while the matrix does; memory = 0: ``iters``
-    local/global iterations, Chebyshev-accelerated with rho, the estimated convergence rate of
-    the plain iteration (0 for plain iterations).
-    Spheres (k): centres, velocities, accels (k,3) move along c0 + v t + a t^2/2 over the
-    nsteps; radii (k,); params (k,6) as for the network's moving spheres (thickness and mu are
-    used: the contact is a projection); impulses (k,7) receives impulse, angular impulse and
-    peak force (N). phis (2,) receives backward Euler's objective (J s^2, up to a constant) at
+    pairs S, Y (memory + 1, nf, 3), their 1 / s.y in rhos and count[0] pairs stored so far,
+    kept from step to step and call to call (the stretch energy's curvature, which the pairs
+    learn, depends on x only; the linear part and the damping directions change, so old pairs
+    are a good, not an exact, model); memory 0 gives plain local/global iterations. Spheres (k): centres, velocities, accels (k,3) move along c0 + v t + a t^2/2
+    over the nsteps; radii (k,); params (k,6) as for the network's moving spheres (thickness
+    and mu are used: the contact is a projection); impulses (k,7) receives impulse, angular
+    impulse and peak force (N). phis (2,) receives the objective (J s^2, up to a constant) at
     the last step's first guess and at its end, before any sphere: how far the iterations got.
     """
     n = x.shape[0]
     nf = int(np.sum(fid >= 0))
     ns = si.shape[0]
     hh = h * h
-    w = hh + h * beta
+    hb = h * beta
     xn = np.empty_like(x)
-    xprev = np.empty_like(x)
+    xt = np.empty_like(x)
     base = np.empty((nf, 3))
-    rhs = np.empty((nf, 3))
+    g = np.empty((nf, 3))
+    gn = np.empty((nf, 3))
+    q = np.empty((nf, 3))
     z = np.empty((nf, 3))
-    sol = np.empty((nf, 3))
-    dirn = np.empty((nf, 3))
+    u = np.zeros((ns, 3))
+    cn = np.zeros(ns)
     diag = np.zeros(nf)
     for i in range(n):
         if fid[i] >= 0:
             diag[fid[i]] = m[i] * (1.0 + h * alpha)
-    for q in range(a_idx.shape[0]):
-        if fid[a_idx[q]] >= 0:
-            diag[fid[a_idx[q]]] += hh * a_k[q] + h * a_c[q]
-    spa = fid[si]
-    spb = fid[sj]
-    kk = hh * k
+    for j in range(a_idx.shape[0]):
+        if fid[a_idx[j]] >= 0:
+            diag[fid[a_idx[j]]] += hh * a_k[j] + h * a_c[j]
     c = np.empty(3)
     vc = np.empty(3)
     imp = np.zeros(6)
     fixed = fid < 0
     total = 0
-    for q in range(impulses.shape[0]):
+    for j in range(impulses.shape[0]):
         for r in range(7):
-            impulses[q, r] = 0.0
+            impulses[j, r] = 0.0
     for step in range(nsteps):
-        # constant part of the right-hand side: M (y + h alpha x_n) + h^2 f + h beta L x_n
-        # + the known positions of fixed neighbours; the first guess is y = x_n + h v_n
+        # the linear part: M (y + h alpha x_n) + h^2 (f + m g) + the anchors' pull and damping;
+        # the first guess is y = x_n + h v_n
         for i in range(n):
             for r in range(3):
                 xn[i, r] = x[i, r]
@@ -529,51 +455,45 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
                 base[p, r] = (m[i] * (y + h * alpha * x[i, r])
                               + hh * (fext[i, r] + m[i] * gravity[r]))
                 x[i, r] = y
-        for q in range(a_idx.shape[0]):
-            p = fid[a_idx[q]]
+        for j in range(a_idx.shape[0]):
+            p = fid[a_idx[j]]
             if p >= 0:
                 for r in range(3):
-                    base[p, r] += hh * a_k[q] * a_pos[q, r] + h * a_c[q] * xn[a_idx[q], r]
+                    base[p, r] += hh * a_k[j] * a_pos[j, r] + h * a_c[j] * xn[a_idx[j], r]
+        # damping directions at the step's start (none for slack cords, as in the explicit
+        # network)
         for s in range(ns):
-            a = si[s]
-            b = sj[s]
-            pa = fid[a]
-            pb = fid[b]
-            for r in range(3):
-                lx = h * beta * k[s] * (xn[a, r] - xn[b, r])
-                if pa >= 0:
-                    base[pa, r] += lx + (w * k[s] * x[b, r] if pb < 0 else 0.0)
-                if pb >= 0:
-                    base[pb, r] += -lx + (w * k[s] * x[a, r] if pa < 0 else 0.0)
-        if memory > 0:
-            total += _lbfgs(x, fid, si, sj, l0, k, tension_only, diag, base, w, hh, iters, tol,
-                            direct, mg, S, Y, rhos, count, rhs, sol, dirn, z, xprev, phis)
-        else:
-            last = step == nsteps - 1
-            if last:
-                phis[0] = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w,
-                                           hh, rhs)
-            _chebyshev(x, xprev, fid, si, sj, spa, spb, l0, kk, tension_only, base, rhs, z, sol,
-                       iters, rho, direct)
-            if last:
-                phis[1] = _energy_gradient(x, fid, si, sj, l0, k, tension_only, diag, base, w,
-                                           hh, rhs)
-            total += iters
+            d0 = xn[si[s], 0] - xn[sj[s], 0]
+            d1 = xn[si[s], 1] - xn[sj[s], 1]
+            d2 = xn[si[s], 2] - xn[sj[s], 2]
+            ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            if ln > 0.0 and not (tension_only[s] and ln < l0[s]):
+                u[s, 0] = d0 / ln
+                u[s, 1] = d1 / ln
+                u[s, 2] = d2 / ln
+                cn[s] = ln
+            else:
+                u[s, 0] = 0.0
+                u[s, 1] = 0.0
+                u[s, 2] = 0.0
+                cn[s] = 0.0
+        total += _lbfgs(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, iters,
+                        tol, direct, mg, S, Y, rhos, count, g, gn, q, z, xt, phis)
         for i in range(n):
             if fid[i] >= 0:
                 for r in range(3):
                     v[i, r] = (x[i, r] - xn[i, r]) / h
         tau = (step + 1) * h
-        for q in range(centres.shape[0]):
+        for j in range(centres.shape[0]):
             for r in range(3):
-                c[r] = centres[q, r] + velocities[q, r] * tau + 0.5 * accels[q, r] * tau * tau
-                vc[r] = velocities[q, r] + accels[q, r] * tau
+                c[r] = centres[j, r] + velocities[j, r] * tau + 0.5 * accels[j, r] * tau * tau
+                vc[r] = velocities[j, r] + accels[j, r] * tau
                 imp[r] = 0.0
                 imp[r + 3] = 0.0
-            jm = _collide(x, xn, v, m, fixed, c, vc, radii[q], params[q, 0], params[q, 3],
+            jm = _collide(x, xn, v, m, fixed, c, vc, radii[j], params[j, 0], params[j, 3],
                           imp)
             for r in range(6):
-                impulses[q, r] += imp[r]
-            if jm / h > impulses[q, 6]:
-                impulses[q, 6] = jm / h
+                impulses[j, r] += imp[r]
+            if jm / h > impulses[j, 6]:
+                impulses[j, 6] = jm / h
     return total

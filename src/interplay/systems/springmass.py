@@ -71,15 +71,14 @@ class SpringNetwork(System):
     fixed: indices of points that never move; strain_limit: a strain above which the state is
     reported unstable; scheme: the implicit integrator, "bdf2" (second order, little numerical
     damping of resolved motion) or "theta" (theta-method: theta = 1 backward Euler, 1/2
-    trapezoidal). integrator="localglobal" minimizes backward Euler's objective each step:
-    lg_memory > 0 by L-BFGS with that many pairs (Liu et al. 2017), at most lg_iterations
-    iterations, stopping when an iteration moves no point by more than lg_tolerance times the
-    first one did; lg_memory = 0 by lg_iterations local/global iterations (Liu et al. 2013),
-    Chebyshev-accelerated with lg_rho (0 = plain; above ~0.97 they can diverge). More
+    trapezoidal). integrator="localglobal" minimizes backward Euler's objective each step
+    (``kernels/localglobal.py``) by L-BFGS with lg_memory pairs (Liu et al. 2017; 0: plain
+    local/global iterations, Liu et al. 2013), at most lg_iterations iterations, stopping when
+    an iteration moves no point by more than lg_tolerance times the first one did. More
     iterations converge towards backward Euler; fewer are cheaper and softer. lg_solver: the
-    constant matrix's inverse as a sparse factor ("direct", exact, cost superlinear in points)
-    or one multigrid V-cycle ("multigrid", L-BFGS only: linear cost, approximate); "auto":
-    multigrid for L-BFGS from MULTIGRID_MIN_POINTS free points. parallel:
+    constant matrix's inverse as a sparse factor ("direct": exact, cost superlinear in points)
+    or one multigrid V-cycle ("multigrid": linear cost, approximate); "auto": multigrid from
+    MULTIGRID_MIN_POINTS free points. parallel:
     explicit spring forces on all threads (per spring, then a per-point gather: equal to the
     serial kernel to round-off); None uses them from ``kernels.parallel.PARALLEL_MIN_SPRINGS``.
     """
@@ -89,7 +88,7 @@ class SpringNetwork(System):
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
-                 scheme="theta", theta=1.0, lg_iterations=10, lg_rho=0.95, lg_memory=3,
+                 scheme="theta", theta=1.0, lg_iterations=10, lg_memory=3,
                  lg_tolerance=1e-4, lg_solver="auto", parallel=None):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
@@ -149,7 +148,6 @@ class SpringNetwork(System):
         self.impulses = np.zeros((0, 7))
         self.cg_iterations = 0
         self.lg_iterations = int(require_positive(name, "lg_iterations", lg_iterations))
-        self.lg_rho = float(lg_rho)
         self.lg_memory = int(require_nonnegative(name, "lg_memory", lg_memory))
         self.lg_tolerance = require_nonnegative(name, "lg_tolerance", lg_tolerance)
         if lg_solver not in LG_SOLVERS:
@@ -332,20 +330,16 @@ class SpringNetwork(System):
 
     def _multigrid(self, unknowns):
         return self.lg_solver == "multigrid" or (
-            self.lg_solver == "auto" and self.lg_memory > 0 and unknowns >= MULTIGRID_MIN_POINTS)
+            self.lg_solver == "auto" and unknowns >= MULTIGRID_MIN_POINTS)
 
     def _localglobal(self, h, n):
         """n local/global steps of h/n with the held forces and any moving spheres."""
-        if self.lg_solver == "multigrid" and self.lg_memory == 0:
-            raise ParameterError(f"{self.name}: lg_solver='multigrid' needs L-BFGS (lg_memory "
-                                 "> 0): plain local/global iterations need the exact solve")
         arr = self._sphere_arrays()
         fid, direct, mg, *history = self._factors(h / n)
         self.lg_taken = LG.localglobal_steps(
             self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k, self.tension_only,
             self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha, self.beta, self.gravity,
-            self.fext, h / n, n, self.lg_iterations, self.lg_rho, self.lg_memory,
-            self.lg_tolerance, direct, mg, *history, arr[0], arr[1], arr[3], arr[4], arr[6],
+            self.fext, h / n, n, self.lg_iterations, self.lg_tolerance, direct, mg, *history, arr[0], arr[1], arr[3], arr[4], arr[6],
             self.impulses, self.lg_objective)
 
     def _explicit(self, h, n):
