@@ -69,7 +69,7 @@ def step_gap(net, seg):
     best = copy.deepcopy(net)
     for k, v in CONVERGED.items():
         setattr(best, k, v)
-    best.lg_memory = best.lg_memory or 5  # Chebyshev rows: converge with L-BFGS
+    best.lg_memory = best.lg_memory or 5  # plain rows: converge with L-BFGS
     drape_step(best, seg)
     mine = copy.deepcopy(net)
     drape_step(mine, seg)
@@ -172,9 +172,9 @@ def runners(args):
                     out[f"ours-lbfgs-{sv}-{it}it"] = (
                         lambda n, first, it=it, sv=sv: ours(n, "localglobal", first,
                                                             lg_iterations=it, lg_solver=sv))
-                out[f"ours-chebyshev-{it}it"] = (
+                out[f"ours-plain-{it}it"] = (  # plain local/global (L-BFGS memory 0)
                     lambda n, first, it=it: ours(n, "localglobal", first, lg_iterations=it,
-                                                 lg_memory=0))
+                                                 lg_memory=0, lg_solver="direct"))
         elif s in ("implicit", "explicit"):
             out[f"ours-{s}"] = lambda n, first, s=s: ours(n, s)
         elif s == "mujoco":
