@@ -5,17 +5,16 @@ points. Instead the forces are computed per spring in parallel into their own ro
 point gathers the forces of its incident springs over a CSR adjacency (point -> springs, with
 the sign of its end), again in parallel and without shared writes. The per-spring arithmetic is
 the serial kernel's (``springs.network_forces``); only the order of the sums differs, so results
-agree to round-off. Below ``PARALLEL_MIN_SPRINGS`` springs the thread start-up and the extra
-pass over the per-spring buffer cost more than they save, and the serial kernel is used.
+agree to round-off.
+
+It is opt-in (``SpringNetwork(parallel=True)``): DESIGN.md measured 1.9x on 2 threads at 59k
+springs, but on this project's 2-core machines (`bench_cloth.py`, 4.9k-326k springs) it ran
+0.5-0.9x the serial step with the other core busy (2026-11-22) and 0.26-0.93x with it idle
+(2026-12-01): the extra pass over the per-spring buffer and the thread start-up cost more than
+the second core gives. Measure on your machine before turning it on.
 """
 import numpy as np
 from numba import njit, prange
-
-# On an idle 2-core machine a 59k-spring cloth step ran 1.9x faster on 2 threads (DESIGN.md).
-# With the other core busy (2026-11-22, `bench_cloth.py --threshold`) the parallel step was
-# 0.5-0.9x the serial one at every size from 5k to 325k springs: on a loaded machine pass
-# SpringNetwork(parallel=False).
-PARALLEL_MIN_SPRINGS = 50000
 
 
 def adjacency(n, si, sj, a_idx):

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
@@ -80,7 +79,7 @@ class SpringNetwork(System):
     or one multigrid V-cycle ("multigrid": linear cost, approximate); "auto": multigrid from
     MULTIGRID_MIN_POINTS free points. parallel:
     explicit spring forces on all threads (per spring, then a per-point gather: equal to the
-    serial kernel to round-off); None uses them from ``kernels.parallel.PARALLEL_MIN_SPRINGS``.
+    serial kernel to round-off); opt-in: on 2 cores it measured slower (``kernels/parallel.py``).
     """
 
     kind = "springmass"
@@ -89,7 +88,7 @@ class SpringNetwork(System):
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
                  scheme="theta", theta=1.0, lg_iterations=10, lg_memory=3,
-                 lg_tolerance=1e-4, lg_solver="auto", parallel=None):
+                 lg_tolerance=1e-4, lg_solver="auto", parallel=False):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -158,8 +157,6 @@ class SpringNetwork(System):
         self.lg_objective = np.zeros(2)  # the last step's objective at its first guess and end
         self._lg = None  # the factored local/global matrix and what it was built from
         self.lg_factorizations = 0
-        if parallel is None:
-            parallel = len(self.si) >= PAR.PARALLEL_MIN_SPRINGS and numba.get_num_threads() > 1
         # point -> spring adjacency (CSR) for the parallel explicit kernel
         self._adj = (PAR.adjacency(len(x), self.si, self.sj, self.a_idx) if parallel else None)
         self.check_step(self.dt)
