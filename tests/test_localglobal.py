@@ -85,7 +85,7 @@ def energy(net):
 def test_stable_without_energy_growth_at_60hz_on_stiff_cloth():
     """Cotton-stiff (200 N), undamped, 1/60 s: 60x the explicit bound, 5 s. A fixed number of
     iterations is not the converged backward-Euler step, so the energy is not monotone step by
-    step (plain iterations measured a 0.13 J rise over seconds here; the Chebyshev-accelerated
+    step (plain iterations measured a 0.13 J rise over seconds here; the L-BFGS
     default does not): the energy never exceeds the initial one, and the highest energy of each
     second does not rise above the one of the second before by more than 2 % of the drop."""
     net = cloth("localglobal", 1 / 60, n=16, stretch=200.0, size=1.0, mass_damping=0.0)
