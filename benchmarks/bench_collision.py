@@ -38,7 +38,7 @@ def wave(x0, t):
 
 
 def points_vs_mesh(steps: int, h: float = 1e-3) -> dict:
-    from interplay.geometry.bvh import BVH
+    from interplay.geometry.aabb_tree import BVH
     from interplay.geometry.shapes import grid
     from interplay.kernels.trimesh_contact import signed_triangle_distance
     x0, tris = grid(1.0, 1.0, 100, 100)

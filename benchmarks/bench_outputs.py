@@ -31,7 +31,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from interplay.io.atomic import atomic_path  # noqa: E402
-from interplay.io.scenefile import RunData, Shape, from_result  # noqa: E402
+from interplay.outputs.rundata import RunData, Shape, from_result  # noqa: E402
 
 SIZE = (1280, 720)
 
@@ -61,9 +61,9 @@ def basketball_run(duration: float) -> RunData:
 
 
 def bench_render(run, video_fps: float, tmp: Path) -> dict:
-    from interplay.render.gl import Renderer, frame_times
-    from interplay.render.overlay import draw_label
-    from interplay.render.video import video_writer
+    from interplay.outputs.render.gl import Renderer, frame_times
+    from interplay.outputs.render.overlay import draw_label
+    from interplay.outputs.render.video import video_writer
     times = frame_times(run.duration, video_fps)
     t0 = time.perf_counter()
     r = Renderer(run, SIZE)
@@ -85,8 +85,8 @@ def bench_render(run, video_fps: float, tmp: Path) -> dict:
 
 
 def bench_export(run, tmp: Path) -> dict:
-    from interplay.io.obj import write_obj_sequence
-    from interplay.io.usd import validate, write_usd
+    from interplay.outputs.obj import write_obj_sequence
+    from interplay.outputs.usd import validate, write_usd
     nf = len(run.times)
     t0 = time.perf_counter()
     path = write_usd(run, tmp / f"{run.scene}.usdc")
@@ -127,7 +127,7 @@ def main(argv=None):
                   f"ms/frame, OBJ {w['obj_ms_per_frame']:.2f} ms/frame, validator errors "
                   f"{w['validator_errors']}")
     try:
-        from interplay.render.gl import gl_context
+        from interplay.outputs.render.gl import gl_context
         report["gl_renderer"] = gl_context().info["GL_RENDERER"]
     except Exception as e:  # the numbers above already say whether GL worked
         report["gl_renderer"] = str(e)

@@ -4,7 +4,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from interplay.fitting import fit_standin
+from interplay.analysis.fitting import fit_standin
 from interplay.scenes import basketball as B
 
 CHECK = B.CHECKPOINTS

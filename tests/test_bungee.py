@@ -8,7 +8,7 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from interplay.cli import main  # noqa: E402
+from interplay.cli.command import main  # noqa: E402
 from interplay.scenes import bungee as B  # noqa: E402
 
 G = 9.81

@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from interplay.io.bvh import BVHError, read_bvh
+from interplay.io.motion_file import BVHError, read_bvh
 from interplay.systems.mocap import MocapFigure
 
 MOCAP = Path(__file__).parents[1] / ".." / "shared" / "data" / "mocap"

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from interplay.cli import main
+from interplay.cli.command import main
 
 
 def run_cli(capsys, *argv):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from interplay.errors import ParameterError
-from interplay.geometry.bvh import BVH
+from interplay.geometry.aabb_tree import BVH
 from interplay.kernels.trimesh_contact import closest_on_triangle, triangles_intersect
 
 

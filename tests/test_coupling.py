@@ -4,14 +4,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from interplay.coupling import plan
+from interplay.coupling.scheduler import plan
 from interplay.errors import SceneError
 from interplay.interactions.contact import SphereCordContact, SpherePlaneContact
 from interplay.scene import Scene
 from interplay.scenes import basketball as B
 from interplay.systems.rigid import Sphere, SphereParams
 from interplay.systems.static import StaticPlane
-from interplay.track import Track
+from interplay.coupling.track import Track
 
 
 def short(params=None, **kw):
@@ -137,7 +137,7 @@ def test_without_refinement_the_blow_up_is_an_error():
 
 
 def test_advisor_says_one_way_for_an_animated_primary():
-    from interplay.analysis import advise
+    from interplay.analysis.advisor import advise
 
     class Animated:
         name, dynamic, accepts_forces = "foot", True, False

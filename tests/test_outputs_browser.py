@@ -115,7 +115,7 @@ class Browser:
 
 @pytest.fixture(scope="module")
 def saved_run(tmp_path_factory):
-    from interplay.cli import main
+    from interplay.cli.command import main
     out = tmp_path_factory.mktemp("run")
     assert main(["run", "basketball", "--duration", "0.5", "--out", str(out), "--quiet"]) == 0
     return out
@@ -212,8 +212,8 @@ def test_usd_imports_into_blender_with_every_system_animated(saved_run, tmp_path
     if not Path(BPY_PYTHON).exists():
         pytest.skip(f"no bpy interpreter at {BPY_PYTHON} (python3 -m venv /tmp/bpyvenv && "
                     "/tmp/bpyvenv/bin/pip install bpy; or set INTERPLAY_BPY_PYTHON)")
-    from interplay.io.obj import quat_matrix
-    from interplay.io.scenefile import load_run
+    from interplay.outputs.obj import quat_matrix
+    from interplay.outputs.rundata import load_run
     run = load_run(saved_run)
     script = tmp_path / "import.py"
     script.write_text(BLENDER_SCRIPT)

@@ -5,8 +5,8 @@ import pytest
 
 from interplay import Scene, SpringNetwork, Springs, StaticPlane
 from interplay.errors import InterplayError, ParameterError
-from interplay.io.obj import quat_matrix, read_obj, write_obj_sequence
-from interplay.io.scenefile import from_result, load_run, write_scene_file
+from interplay.outputs.obj import quat_matrix, read_obj, write_obj_sequence
+from interplay.outputs.rundata import from_result, load_run, write_scene_file
 
 pxr = pytest.importorskip("pxr")
 
@@ -53,7 +53,7 @@ def test_shapes_cover_every_form(ball_result, cloth_result):
 
 def test_usd_round_trip_matches_frames(ball_result, tmp_path):
     from pxr import Usd, UsdGeom
-    from interplay.io.usd import write_usd
+    from interplay.outputs.usd import write_usd
     run = from_result(ball_result)
     path = write_usd(run, tmp_path / "run.usdc")
     stage = Usd.Stage.Open(str(path))
@@ -82,7 +82,7 @@ def test_usd_round_trip_matches_frames(ball_result, tmp_path):
 
 def test_usd_mesh_of_a_deforming_surface(cloth_result, tmp_path):
     from pxr import Usd, UsdGeom
-    from interplay.io.usd import write_usd
+    from interplay.outputs.usd import write_usd
     run = from_result(cloth_result)
     path = write_usd(run, tmp_path / "cloth.usda")
     assert path.read_text().startswith("#usda")
@@ -97,14 +97,14 @@ def test_usd_mesh_of_a_deforming_surface(cloth_result, tmp_path):
 
 
 def test_usd_passes_every_registered_validator(ball_result, cloth_result, tmp_path):
-    from interplay.io.usd import validate, write_usd
+    from interplay.outputs.usd import validate, write_usd
     for name, result in (("ball", ball_result), ("cloth", cloth_result)):
         path = write_usd(from_result(result), tmp_path / f"{name}.usdc")
         assert validate(path) == []
 
 
 def test_usd_bad_format_is_one_clear_error(ball_result, tmp_path):
-    from interplay.io.usd import write_usd
+    from interplay.outputs.usd import write_usd
     with pytest.raises(ParameterError, match="usdc .*usda"):
         write_usd(from_result(ball_result), tmp_path / "run.usdc", fmt="usdz")
 
@@ -158,7 +158,7 @@ def test_load_run_of_a_wrong_directory_says_what_to_pass(tmp_path):
 
 
 def test_unwritable_output_directory_is_one_clear_error(ball_result, tmp_path):
-    from interplay.outputs import OutputOptions, write_outputs
+    from interplay.outputs.writer import OutputOptions, write_outputs
     blocker = tmp_path / "file"
     blocker.write_text("not a directory")
     with pytest.raises(InterplayError, match="cannot write to output directory .*--out"):
@@ -169,7 +169,7 @@ def synthetic_run():
     """A two-segment figure (parts) and spray (particles that come and go, NaN rows when
     absent), written directly: the forms the figure and water systems produce."""
     from interplay.geometry.sphere import icosphere
-    from interplay.io.scenefile import RunData, Shape
+    from interplay.outputs.rundata import RunData, Shape
     v, t = icosphere(1)
     nf = 5
     times = np.arange(nf) / 10.0
@@ -189,7 +189,7 @@ def synthetic_run():
 
 def test_figures_and_spray_export(tmp_path):
     from pxr import Usd, UsdGeom
-    from interplay.io.usd import validate, write_usd
+    from interplay.outputs.usd import validate, write_usd
     run = synthetic_run()
     path = write_usd(run, tmp_path / "s.usdc")
     assert validate(path) == []
@@ -210,7 +210,7 @@ def test_figures_and_spray_export(tmp_path):
 
 
 def test_figures_and_spray_render(tmp_path):
-    from interplay.render.gl import Renderer
+    from interplay.outputs.render.gl import Renderer
     try:
         r = Renderer(synthetic_run(), (160, 90))
     except InterplayError as e:

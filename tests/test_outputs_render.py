@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 
 from interplay.errors import InterplayError, ParameterError
-from interplay.io.scenefile import from_result
-from interplay.render.camera import Camera, default_camera, parse_camera
+from interplay.outputs.rundata import from_result
+from interplay.outputs.render.camera import Camera, default_camera, parse_camera
 
 SIZE = (320, 180)  # small frames keep the default suite fast
 
 
 def _has_gl():
     try:
-        from interplay.render.gl import gl_context
+        from interplay.outputs.render.gl import gl_context
         gl_context()
         return True
     except InterplayError:
@@ -74,7 +74,7 @@ def test_default_camera_sees_every_corner():
 
 @needs_gl
 def test_frame_is_lit_and_not_blank(run):
-    from interplay.render.gl import Renderer
+    from interplay.outputs.render.gl import Renderer
     with Renderer(run, SIZE) as r:
         img = r.render(run, 0.3)
     assert img.shape == (SIZE[1], SIZE[0], 3) and img.dtype == np.uint8
@@ -85,7 +85,7 @@ def test_frame_is_lit_and_not_blank(run):
 
 @needs_gl
 def test_mp4_decodes_with_expected_frames_and_size(run, tmp_path):
-    from interplay.render.video import render_video
+    from interplay.outputs.render.video import render_video
     st = render_video(run, tmp_path / "preview.mp4", SIZE, fps=20)
     meta, frames = _read_mp4(tmp_path / "preview.mp4")
     expected = int(np.floor(run.duration * 20 + 1e-9)) + 1
@@ -97,7 +97,7 @@ def test_mp4_decodes_with_expected_frames_and_size(run, tmp_path):
 
 @needs_gl
 def test_side_by_side_video(run, tmp_path):
-    from interplay.render.video import render_side_by_side
+    from interplay.outputs.render.video import render_side_by_side
     st = render_side_by_side({"two-way": run, "one-way": run, "hybrid": run},
                              tmp_path / "compare.mp4", (480, 180), fps=10)
     meta, frames = _read_mp4(tmp_path / "compare.mp4")
@@ -107,7 +107,7 @@ def test_side_by_side_video(run, tmp_path):
 
 @needs_gl
 def test_crash_while_rendering_leaves_no_video(run, tmp_path):
-    from interplay.render.video import render_video
+    from interplay.outputs.render.video import render_video
 
     def boom(done, total):
         if done == 2:
@@ -118,13 +118,13 @@ def test_crash_while_rendering_leaves_no_video(run, tmp_path):
 
 
 def test_odd_video_size_is_refused(run, tmp_path):
-    from interplay.render.video import render_video
+    from interplay.outputs.render.video import render_video
     with pytest.raises(ParameterError, match="even"):
         render_video(run, tmp_path / "p.mp4", (321, 180))
 
 
 def test_missing_renderer_dependency_is_one_clear_error(run, tmp_path, monkeypatch):
-    from interplay.render import gl
+    from interplay.outputs.render import gl
     monkeypatch.setattr(gl, "_CTX", None)
     monkeypatch.setitem(sys.modules, "moderngl", None)  # import moderngl -> ImportError
     with pytest.raises(InterplayError, match="needs moderngl.*--no-video"):
@@ -132,7 +132,7 @@ def test_missing_renderer_dependency_is_one_clear_error(run, tmp_path, monkeypat
 
 
 def test_missing_encoder_is_one_clear_error(run, tmp_path, monkeypatch):
-    from interplay.render.video import video_writer
+    from interplay.outputs.render.video import video_writer
     monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)
     with pytest.raises(InterplayError, match="needs imageio-ffmpeg"):
         with video_writer(tmp_path / "x.mp4", SIZE, 30):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from interplay.cli import main
+from interplay.cli.command import main
 
 SMALL = ["--size", "320x180", "--video-fps", "15", "--quiet"]
 
@@ -130,7 +130,7 @@ def test_view_of_a_directory_without_a_run(tmp_path, capsys):
 
 def test_missing_gl_driver_fails_before_simulating(tmp_path, capsys, monkeypatch):
     moderngl = pytest.importorskip("moderngl")
-    from interplay.render import gl
+    from interplay.outputs.render import gl
 
     def no_egl(**kw):
         raise Exception("libEGL.so.1: cannot open shared object file")
@@ -145,8 +145,8 @@ def test_missing_gl_driver_fails_before_simulating(tmp_path, capsys, monkeypatch
 def test_viewer_moves_every_system_with_the_slider(tmp_path, capsys):
     pytest.importorskip("viser")
     import socket
-    from interplay.io.scenefile import load_run
-    from interplay.viewer import Viewer
+    from interplay.outputs.rundata import load_run
+    from interplay.cli.viewer import Viewer
     assert main(["run", "basketball", "--duration", "0.2", "--out", str(tmp_path), "--quiet",
                  "--no-video", "--no-usd", "--no-obj", "--no-report"]) == 0
     run = load_run(tmp_path)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from interplay import params as P
-from interplay.cli import main
+from interplay.cli.command import main
 from interplay.errors import ParameterError
 from interplay.scenes import load
 

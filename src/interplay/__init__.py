@@ -13,7 +13,7 @@ __version__ = "0.1.0"
 _EXPORTS = {
     "Scene": "scene",
     "Result": "result",
-    "Track": "track",
+    "Track": "coupling.track",
     "System": "systems.base",
     "RigidBody": "systems.rigid",
     "Sphere": "systems.rigid",

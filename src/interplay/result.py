@@ -5,7 +5,8 @@ import json
 
 import numpy as np
 
-from .analysis import advise, interaction_stats
+from .analysis.advisor import advise
+from .analysis.table import interaction_stats
 from .io.atomic import atomic_path
 
 

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import time as wallclock
 
-from .coupling import as_array_frames, plan, run_passes
+from .coupling.scheduler import as_array_frames, plan, run_passes
 from .errors import SceneError, require_positive
-from .forcelog import ForceLog
+from .coupling.forcelog import ForceLog
 from .interactions.base import MODES
 
 

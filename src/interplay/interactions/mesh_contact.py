@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
-from ..geometry.bvh import BVH, check_points, check_thickness
+from ..geometry.aabb_tree import BVH, check_points, check_thickness
 from ..geometry.sphere import icosphere
-from ..kernels.bvh import deepest_on_segments
+from ..kernels.aabb_tree import deepest_on_segments
 from ..kernels.rigid import quat_to_matrix
 from ..kernels.trimesh_contact import respond, signed_triangle_distance
 from ..systems.colliders import StaticShape

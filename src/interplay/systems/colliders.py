@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError, require_positive
-from ..geometry.bvh import BVH, check_points
+from ..geometry.aabb_tree import BVH, check_points
 from ..geometry.sphere import icosphere
 from ..kernels.trimesh_contact import (box_distance, capsule_distance,
                                        signed_triangle_distance)

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, segment_mesh
-from ..io.bvh import BVHError, Motion, read_bvh
+from ..io.motion_file import BVHError, Motion, read_bvh
 from .base import System
 
 # segment -> (candidate joint names, candidate names of the joint ending its bone)

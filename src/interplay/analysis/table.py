@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-G = 9.81  # m/s^2, the reference acceleration a primary already feels
-
 #: Table I of the paper: (primary, secondary) -> force (min, max, mean) N, acceleration m/s^2
 PAPER_TABLE_I = {
     ("ball", "net"): {"primary_kg": 0.68, "secondary_kg": 0.03, "force_N": (0.0, 59.9, 15.7),
@@ -67,49 +65,3 @@ def interaction_stats(log, window: float = 0.5) -> dict:
         out["standin"] = {"force_N": s["force_N"], "acceleration_m_s2": s["acceleration_m_s2"],
                           "contact_s": s["contact_s"]}
     return out
-
-
-def advise(stats: dict, interaction, one_way_stable: bool | None = None,
-           two_way_cost_s: float | None = None, cost_budget_s: float = 60.0,
-           significant_fraction: float = 0.1) -> dict:
-    """The decision tree of the paper's Figure 17, with the measured reasons.
-
-    significant: mean effective acceleration over contact >= significant_fraction * g.
-    one_way_stable: whether a one-way run of the secondary stayed stable (None: not measured).
-    two_way_cost_s: wall time of a two-way run (None: not measured); expensive above the budget.
-    """
-    if not (interaction.primary.dynamic and interaction.primary.accepts_forces):
-        return {"mode": "one-way", "reasons": [
-            f"{stats['primary']} is prescribed (animation, motion capture or a field): nothing "
-            "can push back on it, so only one-way coupling applies"]}
-    acc = stats["acceleration_m_s2"]
-    ratio = acc["mean"] / G
-    reasons = [f"effective acceleration on {stats['primary']} over contact: mean "
-               f"{acc['mean']:.2f} m/s^2 ({100 * ratio:.1f}% of g), max {acc['max']:.2f} m/s^2"]
-    significant = ratio >= significant_fraction
-    if not significant:
-        reasons.append(f"below {100 * significant_fraction:.0f}% of g: the interaction does not "
-                       "significantly affect the primary")
-        if one_way_stable is False:
-            reasons.append("but the secondary was unstable under one-way coupling")
-        else:
-            reasons.append("the secondary stayed stable under one-way coupling" if one_way_stable
-                           else "one-way stability not measured in this run (assumed stable)")
-            return {"mode": "one-way", "reasons": reasons}
-    else:
-        reasons.append(f"at or above {100 * significant_fraction:.0f}% of g: the interaction "
-                       "significantly affects the primary")
-    supported = getattr(interaction, "two_way_supported", True)
-    expensive = two_way_cost_s is not None and two_way_cost_s > cost_budget_s
-    if two_way_cost_s is not None:
-        reasons.append(f"a two-way run took {two_way_cost_s:.2f} s of wall time (budget "
-                       f"{cost_budget_s:.0f} s)")
-    if supported and not expensive:
-        reasons.append("two-way coupling is implemented and affordable")
-        return {"mode": "two-way", "reasons": reasons}
-    if interaction.standin is not None:
-        reasons.append(f"two-way is {'too expensive' if expensive else 'not implemented'}; "
-                       f"a stand-in ({interaction.standin.name}) is available")
-        return {"mode": "hybrid", "reasons": reasons}
-    reasons.append("no stand-in is available: no good compromise (potential problem)")
-    return {"mode": "problem", "reasons": reasons}

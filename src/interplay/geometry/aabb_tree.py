@@ -1,14 +1,14 @@
 """Bounding-volume hierarchies of triangle (or segment) sets: build once, refit deforming
-objects, transform rigid ones, and query (SPEC 2.5 detection; kernels in kernels/bvh.py).
+objects, transform rigid ones, and query (SPEC 2.5 detection; kernels in kernels/aabb_tree.py).
 
-Not to be confused with io/bvh.py, the Biovision Hierarchy motion-capture reader.
+Not to be confused with io/motion_file.py, the BVH (Biovision Hierarchy) motion-capture reader.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import ParameterError
-from ..kernels import bvh as K
+from ..kernels import aabb_tree as K
 from ..kernels.trimesh_contact import edge_pairs_within, intersecting_pairs
 
 

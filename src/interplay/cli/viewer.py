@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InterplayError
+from ..errors import InterplayError
 
 
 def _viser():
@@ -44,7 +44,7 @@ class Viewer:
 
     def __init__(self, run, host: str = "127.0.0.1", port: int = 8080, log=print):
         viser = _viser()
-        from .render.camera import default_camera
+        from ..outputs.render.camera import default_camera
         self.run, self.log = run, log
         self.times = run.times
         try:
@@ -163,7 +163,7 @@ class Viewer:
 
 def serve(run_dir, host: str = "127.0.0.1", port: int = 8080, log=print):
     """Serve a saved run until interrupted (Ctrl-C); print its URL first."""
-    from .io.scenefile import load_run
+    from ..outputs.rundata import load_run
     run = load_run(Path(run_dir))
     viewer = Viewer(run, host, port, log=log)
     log(f"viewer: {run.scene} ({run.coupling}) at {viewer.url}  (Ctrl-C to stop)")

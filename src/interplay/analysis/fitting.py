@@ -14,7 +14,7 @@ import dataclasses
 import numpy as np
 from scipy.optimize import brentq
 
-from .kernels.rigid import quat_mul
+from ..kernels.rigid import quat_mul
 
 
 def _velocities(result, system: str, t: float):

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import SceneError, StabilityError
+from ..errors import SceneError, StabilityError
 from .forcelog import ForceLog
 from .track import Track, TrackRecorder
 

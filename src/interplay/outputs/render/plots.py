@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InterplayError
-from ..io.atomic import atomic_path
+from ...errors import InterplayError
+from ...io.atomic import atomic_path
 
 G = 9.81  # m/s^2
 MODE_COLORS = {"two-way": "#1f77b4", "one-way": "#d62728", "hybrid": "#2ca02c"}

@@ -14,8 +14,8 @@ import html
 import os
 from pathlib import Path
 
-from .analysis import PAPER_TABLE_I
-from .io.atomic import atomic_path
+from ..analysis.table import PAPER_TABLE_I
+from ..io.atomic import atomic_path
 
 CSS = """
 body{font:15px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:0;
@@ -233,7 +233,7 @@ def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=No
                          ) -> list[Path]:
     """Write the compare report (report.html) into out_dir: the modes side by side.
 
-    runs: {mode: RunData}; rows: {mode: compare row (report_text.mode_row)}; advice: the
+    runs: {mode: RunData}; rows: {mode: compare row (cli.text.mode_row)}; advice: the
     advisor's verdict with the measurements of all modes; mode_reports: {mode: report path};
     pair: (primary, secondary) names of the compared interaction, for the paper's Table I row;
     video_info: what render_side_by_side returned, for the caption.

@@ -9,7 +9,7 @@ import json
 import sys
 from pathlib import Path
 
-from .errors import InterplayError, ParameterError
+from ..errors import InterplayError, ParameterError
 
 MODES = ("two-way", "one-way", "hybrid")
 
@@ -47,12 +47,12 @@ def _output_options(p):
 
 def _outputs(args):
     """OutputOptions from the command line (checked before any simulation runs)."""
-    from .outputs import OutputOptions
-    from .render.camera import parse_camera
+    from ..outputs.writer import OutputOptions
+    from ..outputs.render.camera import parse_camera
     w, x, h = args.size.lower().partition("x")
     if not x or not w.isdigit() or not h.isdigit():
         raise ParameterError(f"--size {args.size}: expected WIDTHxHEIGHT in pixels, e.g. 1280x720")
-    from .render.video import check_size
+    from ..outputs.render.video import check_size
     size = check_size((int(w), int(h)))
     if not 1.0 <= args.video_fps <= 240.0:
         raise ParameterError(f"--video-fps {args.video_fps:g}: choose 1 to 240 frames/s")
@@ -85,8 +85,8 @@ def _parser():
 
 
 def _build_kwargs(args):
-    from . import params as P
-    from .scenes import load
+    from .. import params as P
+    from ..scenes import load
     module = load(args.scene)
     assignments = {}
     for item in args.sets:
@@ -98,7 +98,7 @@ def _build_kwargs(args):
     if args.duration is not None:
         kw["duration"] = args.duration
     if args.integrator is not None:
-        from .systems.springmass import INTEGRATORS
+        from ..systems.springmass import INTEGRATORS
         if args.integrator not in INTEGRATORS:
             raise ParameterError(f"--integrator {args.integrator}: choose one of "
                                  f"{', '.join(INTEGRATORS)}")
@@ -120,12 +120,12 @@ def _run_one(module, mode, kw, out, quiet, console, options=None):
     result = scene.simulate(progress=PassProgress(scene.duration, quiet))
     if options is None:
         return result, result.save(out)
-    from .outputs import write_outputs
+    from ..outputs.writer import write_outputs
     return result, write_outputs(result, out, options)
 
 
 def cmd_list(args, console):
-    from .scenes import REGISTRY
+    from ..scenes import REGISTRY
     for name, (_, text) in sorted(REGISTRY.items()):
         console.print(f"[bold]{name}[/bold]  {text}")
 
@@ -135,10 +135,10 @@ def cmd_run(args, console):
     module, kw = _build_kwargs(args)
     out = Path(args.out or f"out/{args.scene}")
     options = _outputs(args)
-    from .outputs import preflight
+    from ..outputs.writer import preflight
     preflight(out, options)
     result, paths = _run_one(module, args.coupling, kw, out, args.quiet, console, options)
-    from .report_text import print_run
+    from .text import print_run
     print_run(console, result)
     for p in paths:
         console.print(f"wrote {p}")
@@ -152,8 +152,8 @@ def cmd_compare(args, console):
 
 
 def cmd_fit(args, console):
-    from .fitting import fit_standin
-    from .io.atomic import atomic_path
+    from ..analysis.fitting import fit_standin
+    from ..io.atomic import atomic_path
     module, kw = _build_kwargs(args)
     if not hasattr(module, "STANDIN"):
         raise ParameterError(f"scene {args.scene} has no hybrid stand-in to fit")

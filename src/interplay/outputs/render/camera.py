@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ...errors import ParameterError
 
 UP = np.array([0.0, 0.0, 1.0])  # +z up
 

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InterplayError, ParameterError
-from ..io.atomic import atomic_path
+from ...errors import InterplayError, ParameterError
+from ...io.atomic import atomic_path
 from .camera import default_camera
 from .gl import Renderer, frame_times
 from .overlay import draw_label

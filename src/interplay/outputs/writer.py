@@ -18,7 +18,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import InterplayError
+from ..errors import InterplayError
 from .render.camera import Camera
 
 
@@ -59,7 +59,7 @@ def preflight(out_dir, options: OutputOptions) -> Path:
     video). Each failure is one InterplayError naming the fix."""
     d = ensure_writable(out_dir)
     if options.usd:
-        from .io.usd import _pxr
+        from .usd import _pxr
         _pxr()
     if options.video:
         from .render.gl import gl_context
@@ -113,7 +113,7 @@ def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
     each output land in ``options.timings`` (s): usd_s, obj_s, video_render_s,
     video_encode_s, report_s.
     """
-    from .io.scenefile import from_result, write_scene_file
+    from .rundata import from_result, write_scene_file
     out = ensure_writable(out_dir)
     summary = summary if summary is not None else result.summary()
     run = from_result(result)
@@ -123,13 +123,13 @@ def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
     paths.append(write_scene_file(run, out))
     files["shapes for the viewer"] = paths[-1]
     if options.usd:
-        from .io.usd import write_usd
+        from .usd import write_usd
         p = _timed(tm, "usd_s", write_usd, run, out / f"run.{options.usd_format}",
                    options.usd_format)
         paths.append(p)
         files["USD stage"] = p
     if options.obj:
-        from .io.obj import write_obj_sequence
+        from .obj import write_obj_sequence
         _timed(tm, "obj_s", write_obj_sequence, run, out / "obj",
                StepBar("OBJ sequence", options.quiet))
         paths.append(out / "obj")
@@ -157,8 +157,8 @@ def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
                           options: OutputOptions = OutputOptions(),
                           mode_dirs: dict | None = None) -> list[Path]:
     """The compare level: compare.mp4 (the modes side by side) and report.html linking each
-    mode's own report. results: {mode: Result}; rows: {mode: report_text.mode_row}."""
-    from .io.scenefile import from_result
+    mode's own report. results: {mode: Result}; rows: {mode: cli.text.mode_row}."""
+    from .rundata import from_result
     out = ensure_writable(out_dir)
     runs = {m: from_result(r) for m, r in results.items()}
     paths = []

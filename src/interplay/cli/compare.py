@@ -4,9 +4,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .io.atomic import atomic_path
+from ..io.atomic import atomic_path
 from .progress import PassProgress
-from .report_text import mode_row
+from .text import mode_row
 
 MODES = ("two-way", "one-way", "hybrid")
 
@@ -17,7 +17,7 @@ def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> 
     options: an outputs.OutputOptions to also write each mode's USD, OBJ, video and report,
     and the side-by-side video and compare report in out (None: summary and tracks only)."""
     if options is not None:
-        from .outputs import preflight
+        from ..outputs.writer import preflight
         preflight(out, options)
     results = {}
     for mode in MODES:
@@ -33,7 +33,7 @@ def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> 
         if options is None:
             paths += r.save(out / mode, summary)
         else:
-            from .outputs import write_outputs
+            from ..outputs.writer import write_outputs
             paths += write_outputs(r, out / mode, options, summary)
         rows[mode] = mode_row(r)
     advice = results["two-way"].advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
@@ -43,7 +43,7 @@ def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> 
         tmp.write_text(json.dumps(report, indent=2))
     paths.append(path)
     if options is not None:
-        from .outputs import write_compare_outputs
+        from ..outputs.writer import write_compare_outputs
         paths += write_compare_outputs(results, out, rows, advice, options)
     _print_table(console, rows, advice)
     for p in paths:

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InterplayError
-from .atomic import atomic_path
+from ..io.atomic import atomic_path
 
 SCENE_FILE = "scene.json"
 QUATERNION_KEYS = ("orientation", "segment_orientations")  # (w, x, y, z), last axis

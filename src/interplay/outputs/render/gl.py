@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..errors import InterplayError
+from ...errors import InterplayError
 from . import shaders
 from .camera import Camera, default_camera
 
@@ -66,7 +66,7 @@ def quat_matrix4(pos, q) -> np.ndarray:
 
 def ground_shape(lo, hi):
     """A floor quad (a static Shape) just under the box [lo, hi], 20 m or 10 box sizes wide."""
-    from ..io.scenefile import Shape
+    from ..rundata import Shape
     c = (np.asarray(lo) + np.asarray(hi)) / 2
     s = max(10.0, 5 * float(np.max(np.asarray(hi) - np.asarray(lo))))
     z = float(lo[2]) - 1e-3
@@ -88,7 +88,7 @@ def _unit_cylinder(sides=6):
 
 
 def _unit_sphere(sub=1):
-    from ..geometry.sphere import icosphere
+    from ...geometry.sphere import icosphere
     v, t = icosphere(sub)
     return v, v, t
 

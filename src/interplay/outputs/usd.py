@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InterplayError, ParameterError
-from .atomic import atomic_path
+from ..io.atomic import atomic_path
 
 FORMATS = ("usdc", "usda")
 
