@@ -92,7 +92,7 @@ def bench_modes(repeats) -> dict:
 
 
 def bench_variants(repeats, modes) -> dict:
-    p = B.PARAMS()
+    p = B.BasketballParams()
     tw = modes["two-way"]
     out = {"explicit_default_subcycled": {
         "description": f"default: explicit net dt {p.net.dt:g} s, contact sub-cycled, "
@@ -104,7 +104,7 @@ def bench_variants(repeats, modes) -> dict:
                                           lambda: B.build("two-way", dt=5e-5)),
             REF: ("explicit net, strict lock step: dt = coupling_dt = 1e-5 s", 1e-5, 1e-5,
                   lambda: B.build("two-way", dt=1e-5,
-                                  params=dataclasses.replace(B.PARAMS(), coupling_dt=1e-5))),
+                                  params=dataclasses.replace(B.BasketballParams(), coupling_dt=1e-5))),
             "implicit_dt1e-4": ("implicit net dt 1e-4 s, coupling_dt 1e-3 s", 1e-4,
                                 p.coupling_dt,
                                 lambda: B.build("two-way", integrator="implicit", dt=1e-4))}
@@ -129,7 +129,7 @@ def bench_variants(repeats, modes) -> dict:
 # --- MuJoCo ----------------------------------------------------------------------------------
 def mj_model(mujoco, timestep: float):
     """The scene as an MjModel (see the module docstring); returns (model, compile seconds)."""
-    p = B.PARAMS()
+    p = B.BasketballParams()
     netp, ballp = p.net, p.ball
     x, pairs = net_knots(netp)
     l0 = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
@@ -204,14 +204,14 @@ def mj_settle(mujoco, model, seconds=1.0, boost=30.0):
 def mj_start(mujoco, model, qpos):
     d = mujoco.MjData(model)
     d.qpos[:] = qpos
-    d.qvel[:3] = B.PARAMS().ball.velocity
+    d.qvel[:3] = B.BasketballParams().ball.velocity
     mujoco.mj_forward(model, d)
     return d
 
 
 def mj_check(mujoco, model, qpos) -> dict:
     """A run in 1 ms chunks that watches the stability criteria."""
-    netp = B.PARAMS().net
+    netp = B.BasketballParams().net
     ts = model.opt.timestep
     d = mj_start(mujoco, model, qpos)
     knots = model.body("knot0").id

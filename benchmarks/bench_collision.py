@@ -38,14 +38,14 @@ def wave(x0, t):
 
 
 def points_vs_mesh(steps: int, h: float = 1e-3) -> dict:
-    from interplay.geometry.aabb_tree import BVH
+    from interplay.geometry.aabb_tree import AABBTree
     from interplay.geometry.shapes import grid
     from interplay.kernels.trimesh_contact import signed_triangle_distance
     x0, tris = grid(1.0, 1.0, 100, 100)
     rng = np.random.default_rng(0)
     pts = np.column_stack([rng.uniform(0, 1, 10_000), rng.uniform(0, 1, 10_000),
                            rng.uniform(-0.03, 0.03, 10_000)])
-    tree = BVH(wave(x0, 0.0), tris)  # point queries carry the thickness in their radius
+    tree = AABBTree(wave(x0, 0.0), tris)  # point queries carry the thickness in their radius
     frames = [wave(x0, k * h) for k in range(steps + 1)]
     refit, query, dist, found = [], [], [], 0
     for k in range(steps):

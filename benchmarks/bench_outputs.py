@@ -56,8 +56,8 @@ def cloth_run(n: int = 64, duration: float = 1.5, fps: float = 60.0) -> RunData:
 
 
 def basketball_run(duration: float) -> RunData:
-    from interplay.scenes import load
-    return from_result(load("basketball").build("two-way", duration=duration).simulate())
+    from interplay.scenes import spec
+    return from_result(spec("basketball").build("two-way", duration=duration).simulate())
 
 
 def bench_render(run, video_fps: float, tmp: Path) -> dict:

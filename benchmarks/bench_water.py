@@ -34,9 +34,9 @@ def bench_pond(repeats, duration):
         t0 = time.perf_counter()
         last = scene.simulate()
         walls.append(time.perf_counter() - t0)
-    d = last.diagnostics()["water"]
+    d = last.diagnostics["water"]
     med = statistics.median(walls)
-    return {"grid": list(scene.systems[0].shape), "balls": pond.PARAMS().balls.count,
+    return {"grid": list(scene.systems[0].shape), "balls": pond.PondParams().balls.count,
             "duration_s": duration, "wall_s": stats(walls),
             "sim_s_per_wall_s": duration / med, "peak_particles": d["peak_particles"],
             "volume_drift_rel": d["volume_drift_rel"], "steps": last.passes[0].steps}

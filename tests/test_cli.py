@@ -25,7 +25,7 @@ def test_run_writes_summary_and_tracks(tmp_path, capsys):
     assert s["coupling"] == "hybrid" and s["duration_s"] == 0.7
     assert {"primary_pass_s", "secondary_pass_s", "total_s"} <= set(s["timings"])
     net = next(x for x in s["systems"] if x["name"] == "net")
-    assert net["kind"] == "springmass" and net["mass_kg"] == pytest.approx(0.03)
+    assert net["type"] == "SpringNetwork" and net["role"] == "dynamic" and net["mass_kg"] == pytest.approx(0.03)
     assert net["integrator"] == "explicit" and net["dt_s"] > 0
     it = next(x for x in s["interactions"] if x["name"] == "ball-net")
     assert set(it["force_N"]) == {"min", "max", "mean"} and len(it["contact_s"]) == 2

@@ -18,8 +18,9 @@ A = 0.05  # m, the cube's half side
 H = 1e-3  # s, the step
 
 
-def cube(z=0.1, m=1.0):
-    return RigidBody("cube", m, [m * (2 * A) ** 2 / 6] * 3, H, position=(0, 0, z))
+def cube(z=0.1, m=1.0, name="cube", surface=None):
+    return RigidBody(name, m, [m * (2 * A) ** 2 / 6] * 3, H, position=(0, 0, z),
+                     surface=box_surface([A] * 3) if surface is None else surface)
 
 
 def step(systems, contacts, h=H):
@@ -36,7 +37,7 @@ def test_cube_rests_on_the_ground_through_the_scene():
     box = scene.add(cube())
     floor = scene.add(StaticPlane("floor"))
     p = MeshContactParams()
-    scene.connect(MeshContact("cube-floor", box, floor, p, surfaces={"cube": box_surface([A] * 3)}))
+    scene.connect(MeshContact("cube-floor", box, floor, p))
     res = scene.simulate()
     x, v = res.state_at("cube", 2.0)
     # rests at the contact thickness: within g h^2 (one step's fall) of it, not sinking
@@ -63,7 +64,7 @@ def run_slope(theta, mu=0.5, seconds=1.0):
     box.x[:] = R @ [0, 0, A + p.thickness]
     # the cube's orientation: the slope's rotation about y, as a quaternion (w, x, y, z)
     box.q[:] = [np.cos(-theta / 2), 0, np.sin(-theta / 2), 0]
-    contact = MeshContact("c", box, slope, p, surfaces={"cube": box_surface([A] * 3)})
+    contact = MeshContact("c", box, slope, p)
     contact.prepare(H)
     pos = []
     for _ in range(int(seconds / H)):
@@ -179,33 +180,30 @@ def test_static_shapes_signed_distance(shape, inside, outside):
 def test_bad_input_messages():
     box = cube()
     floor = StaticPlane("floor")
-    surf = {"cube": box_surface([A] * 3)}
     with pytest.raises(ParameterError, match=r"c: friction must be zero or positive, got -0.2; "
                                              r"use 0 for frictionless"):
-        MeshContact("c", box, floor, MeshContactParams(friction=-0.2), surfaces=surf)
+        MeshContact("c", box, floor, MeshContactParams(friction=-0.2))
     with pytest.raises(ParameterError, match=r"c: contact thickness must be zero or positive "
                                              r"\(m\), got -0.01"):
-        MeshContact("c", box, floor, MeshContactParams(thickness=-0.01), surfaces=surf)
+        MeshContact("c", box, floor, MeshContactParams(thickness=-0.01))
     with pytest.raises(ParameterError, match=r"c: both floor and ground are static"):
         MeshContact("c", floor, StaticPlane("ground"))
-    contact = MeshContact("c", box, floor, surfaces=surf)
+    contact = MeshContact("c", box, floor)
     contact.prepare(H)
     box.x[2] = np.nan
     with pytest.raises(ParameterError, match=r"cube: positions of point 0 is not finite.*reduce "
                                              r"the step"):
         contact.exchange(True, True)
     with pytest.raises(ParameterError, match=r"cube: a collision mesh needs at least one"):
-        MeshContact("c", cube(), floor, surfaces={"cube": (np.zeros((3, 3)),
-                                                           np.zeros((0, 3), np.int64))})
+        MeshContact("c", cube(surface=(np.zeros((3, 3)), np.zeros((0, 3), np.int64))), floor)
 
 
 def test_cube_stacked_on_a_cube_on_a_table_rests_and_forces_balance():
-    lower = RigidBody("lower", 1.0, [1.0 * (2 * A) ** 2 / 6] * 3, H, position=(0, 0, 0.06))
-    upper = RigidBody("upper", 0.5, [0.5 * (2 * A) ** 2 / 6] * 3, H, position=(0, 0, 0.2))
+    lower = cube(0.06, 1.0, "lower")
+    upper = cube(0.2, 0.5, "upper")
     table = StaticBox("table", (0, 0, -0.5), (1, 1, 0.5))
-    surf = {"lower": box_surface([A] * 3), "upper": box_surface([A] * 3)}
-    on_table = MeshContact("lower-table", lower, table, surfaces=surf)
-    stacked = MeshContact("upper-lower", upper, lower, surfaces=surf)
+    on_table = MeshContact("lower-table", lower, table)
+    stacked = MeshContact("upper-lower", upper, lower)
     for c in (on_table, stacked):
         c.prepare(H)
     seen = 0

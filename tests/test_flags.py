@@ -5,11 +5,12 @@ import pytest
 from interplay import params as P
 from interplay.errors import SceneError
 from interplay.scenes import flags
+from interplay.systems.springmass import SpringNetwork
 
 
 def small():
     """Coarse flags so the scene runs in a couple of seconds."""
-    p = flags.PARAMS()
+    p = flags.FlagsParams()
     for name, (nu, nv) in {"cotton": (10, 7), "nylon": (8, 6), "canvas": (10, 7)}.items():
         p = P.apply(p, {f"{name}.nu": str(nu), f"{name}.nv": str(nv)})
     return p
@@ -17,7 +18,7 @@ def small():
 
 def test_flags_stream_downwind():
     scene = flags.build(duration=1.0, params=small())
-    cloths = {s.name: s for s in scene.systems if s.kind == "springmass"}
+    cloths = {s.name: s for s in scene.systems if isinstance(s, SpringNetwork)}
     pinned = {n: c.x[c.fixed].copy() for n, c in cloths.items()}
     result = scene.simulate()
     assert not result.warnings
@@ -33,11 +34,14 @@ def test_flags_stream_downwind():
     # the air's reaction is logged on the wind (drag pushes the wind back: -x)
     stats = {s["name"]: s for s in result.interaction_stats()}
     assert stats["wind-canvas"]["force_N"]["max"] > stats["wind-nylon"]["force_N"]["max"] > 0
-    assert "cotton" in result.frames and "cotton-pole" in result.frames
+    # the poles are set pieces: drawn, static, with no frames and no pass of their own
+    assert "cotton" in result.frames and "cotton-pole" not in result.frames
+    assert {s.name: s.form for s in result.shapes}["cotton-pole"] == "static"
+    assert [p["systems"] for p in result.passes] == [["cotton"], ["nylon"], ["canvas"]]
 
 
 def test_every_builder_parameter_is_settable():
-    keys = P.keys(flags.PARAMS())
+    keys = P.keys(flags.FlagsParams())
     assert {"wind.speed", "wind.gust", "aero.drag", "cotton.density", "canvas.stretch",
             "nylon.integrator", "nylon.dt"} <= set(keys)
     p = P.apply(small(), {"wind.speed": "0", "wind.cross": "0", "cotton.integrator": "explicit",
@@ -47,5 +51,5 @@ def test_every_builder_parameter_is_settable():
 
 
 def test_hybrid_is_refused():
-    with pytest.raises(SceneError, match="the wind has no stand-in"):
-        flags.build("hybrid")
+    with pytest.raises(SceneError, match="flags supports one-way coupling, not hybrid"):
+        flags.SPEC.check_coupling("hybrid")

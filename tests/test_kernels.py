@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from interplay.kernels import springs as K
-from interplay.kernels.contact import sphere_segments
-from interplay.kernels.subcycle import substep_with_spheres
+from interplay.kernels.contact import Colliders, Sphere, sphere_elements
+from interplay.kernels.subcycle import advance_with_colliders
 
 
 def random_network(n=12, seed=0):
@@ -35,7 +35,18 @@ def numpy_forces(x, v, m, si, sj, l0, k, kd, tonly, alpha, g, fext):
     return f
 
 
-NO_ANCHORS = (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0))
+NO_ANCHORS = K.Anchors(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0))
+
+
+def network(x, v, m, si, sj, l0, k, kd, tonly, alpha, g, fixed=None):
+    """The kernels' bundle of a network without anchors."""
+    fixed = np.zeros(len(x), bool) if fixed is None else fixed
+    return K.Network(K.Points(x, v, m, fixed), K.SpringSet(si, sj, l0, k, kd, tonly),
+                     NO_ANCHORS, alpha, g)
+
+
+def scheme(theta, bdf2, xp, vp, tol):
+    return K.Scheme(True, theta, bdf2, tol, 500, xp, vp)
 
 
 def test_network_forces_match_numpy():
@@ -43,7 +54,7 @@ def test_network_forces_match_numpy():
     g = np.array([0, 0, -9.81])
     fext = np.random.default_rng(1).normal(size=x.shape)
     f = np.zeros_like(x)
-    K.network_forces(x, v, m, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.3, g, fext, f)
+    K.network_forces(network(x, v, m, si, sj, l0, k, kd, tonly, 0.3, g), fext, f)
     np.testing.assert_allclose(f, numpy_forces(x, v, m, si, sj, l0, k, kd, tonly, 0.3, g, fext),
                                rtol=1e-12, atol=1e-12)
 
@@ -101,9 +112,9 @@ def test_implicit_step_matches_dense_solve(theta):
     A = np.diag(np.repeat(m, 3)) - theta * h * Dd - (theta * h) ** 2 * Kd
     dv_ref = solve_free(A, h * (f + theta * h * Kd @ v.ravel()), fixed)
     x1, v1 = x.copy(), v.copy()
-    K.implicit_step(x1, v1, m, fixed, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.2, g, fext, kext,
-                    dext, np.zeros_like(x), np.zeros_like(x), h, theta, False, False,
-                    np.zeros_like(x), np.zeros_like(x), 1e-12, 500)
+    K.implicit_step(network(x1, v1, m, si, sj, l0, k, kd, tonly, 0.2, g, fixed),
+                    K.Load(fext, kext, dext, np.zeros_like(x)), np.zeros_like(x), h,
+                    scheme(theta, False, np.zeros_like(x), np.zeros_like(x), 1e-12), False)
     # CG to a 1e-12 relative residual: dv agrees to ~1e-10 relative to its size
     np.testing.assert_allclose(v1 - v, dv_ref, atol=1e-9 * np.abs(dv_ref).max())
     np.testing.assert_allclose(x1, x + h * (v + theta * dv_ref), atol=1e-9)
@@ -121,8 +132,9 @@ def test_bdf2_step_matches_dense_solve():
     h = 5e-3
     xp, vp = np.zeros_like(x), np.zeros_like(x)
     x1, v1 = x.copy(), v.copy()
-    K.implicit_step(x1, v1, m, fixed, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.0, g, z3, z33, z33,
-                    z3, np.zeros_like(x), h, 1.0, True, False, xp, vp, 1e-13, 500)
+    K.implicit_step(network(x1, v1, m, si, sj, l0, k, kd, tonly, 0.0, g, fixed),
+                    K.Load(z3, z33, z33, z3), np.zeros_like(x), h, scheme(1.0, True, xp, vp, 1e-13),
+                    False)
     np.testing.assert_array_equal(xp, x)  # the first step is backward Euler and records x, v
     # the dense BDF2 step from (x1, v1) with previous state (x, v)
     hs = 2 * h / 3
@@ -132,8 +144,9 @@ def test_bdf2_step_matches_dense_solve():
     rhs = np.repeat(m, 3) * (v1 - v).ravel() / 3 + hs * (f + Kd @ y)
     dv_ref = solve_free(A, rhs, fixed)
     x2, v2 = x1.copy(), v1.copy()
-    K.implicit_step(x2, v2, m, fixed, si, sj, l0, k, kd, tonly, *NO_ANCHORS, 0.0, g, z3, z33, z33,
-                    z3, np.zeros_like(x), h, 1.0, True, True, xp, vp, 1e-13, 500)
+    K.implicit_step(network(x2, v2, m, si, sj, l0, k, kd, tonly, 0.0, g, fixed),
+                    K.Load(z3, z33, z33, z3), np.zeros_like(x), h, scheme(1.0, True, xp, vp, 1e-13),
+                    True)
     np.testing.assert_allclose(v2 - v1, dv_ref, atol=1e-8 * np.abs(dv_ref).max())
     np.testing.assert_allclose(x2, x1 + (x1 - x) / 3 + hs * (v1 + dv_ref), atol=1e-10)
 
@@ -146,24 +159,21 @@ def brute_closest(c, a, b, samples=200001):
     return t[i], d[i]
 
 
-def test_sphere_segments_against_brute_force():
+def test_sphere_elements_against_brute_force():
     rng = np.random.default_rng(7)
     n = 30
     x = rng.uniform(-0.3, 0.3, size=(n, 3))
     seg = np.array([(i, (i + 1) % n) for i in range(n)], dtype=np.int64)
     c = np.zeros(3)
     R, th, cs = 0.2, 0.01, 1000.0
-    ns = len(seg)
-    idx = np.zeros(2 * ns, np.int64)
-    f = np.zeros((2 * ns, 3))
-    kx = np.zeros((2 * ns, 3, 3))
-    dx = np.zeros((2 * ns, 3, 3))
-    vr = np.zeros((2 * ns, 3))
+    out = K.point_forces(2 * len(seg))
     wrench = np.zeros(6)
     zeros = np.zeros((n, 3))
-    cnt = sphere_segments(c, np.zeros(3), np.zeros(3), R, 1.0, np.zeros(3), x, zeros,
-                          np.ones(n), zeros, seg, th, cs, 0.0, 0.0, 0.05, False, -1.0, idx, f, kx, dx,
-                          vr, wrench)
+    ball = Sphere(c, np.zeros(3), np.zeros(3), R, 1.0, np.zeros(3))
+    pts = K.Points(x, zeros, np.ones(n), np.zeros(n, bool))
+    law = np.array([th, cs, 0.0, 0.0, 0.05, 0.0])
+    cnt = sphere_elements(ball, pts, zeros, seg, law, -1.0, out, True, wrench)
+    f = out.f
     expected = np.zeros(3)
     touching = 0
     for a, b in seg:
@@ -190,21 +200,20 @@ def test_subcycled_contact_conserves_momentum():
     m = np.full(n, 0.03 / n)
     v = np.zeros_like(x)
     p0 = (m[:, None] * v).sum(axis=0)
-    centres = np.array([[0.05, 0.0, 3.05]])
-    vel = np.array([[0.3, 0.0, -4.0]])
-    imp = np.zeros((1, 7))
-    params = np.array([[0.003, 2e3, 0.5, 1.0, 0.05, 1.0]])
+    cols = Colliders(np.array([[0.05, 0.0, 3.05]]), np.array([[0.3, 0.0, -4.0]]),
+                     np.zeros((1, 3)), np.zeros((1, 3)), np.array([0.12]), np.array([0.68]),
+                     np.array([[0.003, 2e3, 0.5, 1.0, 0.05, 1.0]]), np.zeros((1, 7)))
     z3 = np.zeros((n, 3))
     z33 = np.zeros((n, 3, 3))
+    net = network(x, v, m, pairs[:, 0].copy(), pairs[:, 1].copy(), l0, k, 2e-4 * k,
+                  np.ones(len(l0), bool), 0.0, np.zeros(3))
+    explicit = K.Scheme(False, 1.0, False, 1e-8, 100, z3, z3)
     total = np.zeros(3)
     for _ in range(100):
-        substep_with_spheres(x, v, m, np.zeros(n, bool), pairs[:, 0].copy(), pairs[:, 1].copy(),
-                             l0, k, 2e-4 * k, np.ones(len(l0), bool), *NO_ANCHORS, 0.0,
-                             np.zeros(3), z3, z33, z33, z3, np.zeros_like(x), 1e-3, 20, False,
-                             1.0, False, False, z3, z3, 1e-8, 100, pairs, centres, vel, np.zeros((1, 3)),
-                             np.array([0.12]), np.array([0.68]), np.zeros((1, 3)), params, imp)
-        total += imp[0, :3]
-        centres += vel * 1e-3
+        advance_with_colliders(net, K.Load(z3, z33, z33, z3), np.zeros_like(x), 1e-3, 20,
+                               explicit, False, cols, pairs)
+        total += cols.impulses[0, :3]
+        cols.centres[:] += cols.velocities * 1e-3
     p1 = (m[:, None] * v).sum(axis=0)
     assert np.linalg.norm(total) > 1e-3  # the sphere really hit the net
     np.testing.assert_allclose(p1 - p0, -total, atol=1e-12)

@@ -14,7 +14,7 @@ from interplay.geometry import shapes
 
 def test_leaves_lift_fall_and_rest():
     # 12 coarse leaves, the rider passing x = 0 at 0.5 s; 2.5 s leaves ~1.5 s to settle
-    p = P.apply(leaves.PARAMS(), {"leaves.count": "12", "leaves.stations": "3",
+    p = P.apply(leaves.LeavesParams(), {"leaves.count": "12", "leaves.stations": "3",
                                   "leaves.rows": "1", "rider.pass_time": "0.5",
                                   "rider.start": "-3"})
     scene = leaves.build(duration=2.5, fps=30, params=p)
@@ -30,7 +30,7 @@ def test_leaves_lift_fall_and_rest():
     assert np.allclose(net.x[:, 2], p.ground.thickness, atol=2e-4)
     assert net.strain() < 0.05
     assert {"bicyclist", "leaves"} <= set(result.frames)
-    assert result.scene.primary.name == "bicyclist"
+    assert result.primary == "bicyclist"
 
 
 @pytest.mark.parametrize("integrator,dt", [("implicit", 1 / 240), ("explicit", 2e-4)])
@@ -56,5 +56,5 @@ def test_a_dropped_cloth_rests_on_the_ground_with_friction(integrator, dt):
 
 
 def test_hybrid_is_refused():
-    with pytest.raises(SceneError, match="the wake has no stand-in"):
-        leaves.build("hybrid")
+    with pytest.raises(SceneError, match="leaves supports one-way coupling, not hybrid"):
+        leaves.SPEC.check_coupling("hybrid")

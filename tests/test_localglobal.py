@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from interplay.errors import ParameterError
-
 from interplay.geometry import shapes
 from interplay.kernels import localglobal as LG
+from interplay.kernels import springs as K
+from interplay.kernels.contact import colliders
 from interplay.systems.springmass import SpringNetwork, Springs
 
 
@@ -21,6 +21,18 @@ def cloth(integrator, dt, n=8, stretch=20.0, size=0.3, **kw):
                                    fixed=[0, n - 1], **kw)
 
 
+def fixed_sphere(net, radius, law, points=False):
+    """Sub-cycle a fixed sphere at the origin (radius m, a contact law row) against the
+    network's springs or (points=True) its points in its next advance; returns the batch,
+    whose impulses the advance fills."""
+    cols = colliders(1)
+    cols.radii[0], cols.masses[0], cols.law[0] = radius, 1e9, law
+    n = len(net.x)
+    elems = np.stack([np.arange(n)] * 2, axis=1) if points else net.segments()
+    assert net.subcycle(cols, elems)
+    return cols
+
+
 def hang(net, seconds=0.25, h=0.01):
     for _ in range(int(round(seconds / h))):
         net.clear_forces()
@@ -31,8 +43,8 @@ def hang(net, seconds=0.25, h=0.01):
 def test_lu_solve_matches_the_matrix():
     net = cloth("localglobal", 1 / 60)
     h, alpha, beta = 1 / 60, 0.3, 1e-3
-    fid, A_lg = LG.system_matrix(net.m, net.fixed, net.si, net.sj, net.k, net.a_idx, net.a_k,
-                                 net.a_c, alpha, beta, h)
+    net.alpha = alpha
+    fid, A_lg = LG.system_matrix(net.bundle(), beta, h)
     lu = LG.factor(A_lg)
     n, free = len(net.m), ~net.fixed
     w = (h * h + h * beta) * net.k
@@ -42,7 +54,7 @@ def test_lu_solve_matches_the_matrix():
     A = (sp.diags(net.m * (1 + h * alpha)) + lap).tocsr()[free][:, free]
     b = np.random.default_rng(0).normal(size=(int(free.sum()), 3))
     out = np.empty_like(b)
-    LG.ldl_solve(*lu, b, np.empty_like(b), out)
+    LG.ldl_solve(lu, b, np.empty_like(b), out)
     assert np.allclose(A @ out, b, rtol=0, atol=1e-12 * np.abs(b).max())
     assert np.array_equal(fid[free], np.arange(free.sum())) and np.all(fid[~free] == -1)
 
@@ -139,9 +151,10 @@ def test_tension_only_cord_goes_slack():
     assert net.v[1, 0] < -0.1
 
 
-def test_external_forces_and_sphere_projection():
+def test_external_forces_and_sphere_contact():
     """Held external forces enter the step (a wind pushing +x); a fixed sphere under a falling
-    cloth keeps every point outside it and receives a downward impulse."""
+    cloth keeps every point outside it but for the law's give and receives a downward
+    impulse."""
     net = cloth("localglobal", 1 / 120, n=8, gravity=(0, 0, 0))
     net.fext[:, 0] = 1e-3
     net.advance(0.1)
@@ -149,15 +162,20 @@ def test_external_forces_and_sphere_projection():
     x, t = shapes.grid(0.6, 0.6, 12, 12, origin=(-0.3, -0.3, 0.2))
     net = SpringNetwork.from_mesh("c", x, t, 0.05, 50.0, dt=1 / 120, integrator="localglobal",
                                   mass_damping=0.1)
-    contact = (0.005, 2e3, 0.01, 0.3, 0.01, 0.0)
+    law = np.array([0.005, 2e3, 0.01, 0.3, 0.01, 0.0])
     total = np.zeros(3)
     for _ in range(60):
         net.clear_forces()
-        net.add_moving_sphere(net.segments(), np.zeros(3), np.zeros(3), np.zeros(3),
-                              np.zeros(3), 0.15, 1e9, contact)
+        cols = fixed_sphere(net, 0.15, law)
         net.advance(1 / 60)
-        total += net.impulses[0, :3]
-        assert np.linalg.norm(net.x, axis=1).min() >= 0.155 - 1e-12
+        total += cols.impulses[0, :3]
+        # the law gives under a resting load F by F / c_s; no point is pressed harder than its
+        # weight and the pull of all its stretched springs together
+        pull = net.k * np.maximum(np.linalg.norm(net.x[net.si] - net.x[net.sj], axis=1)
+                                  - net.l0, 0.0)
+        load = np.bincount(net.si, pull, len(net.x)) + np.bincount(net.sj, pull, len(net.x))
+        give = (load + net.m * 9.81).max() / law[1]
+        assert np.linalg.norm(net.x, axis=1).min() >= 0.155 - give
     assert total[2] < 0 and net.x[:, 2].min() < 0.0  # it drapes around the sphere
 
 
@@ -195,11 +213,10 @@ def test_point_and_segment_sphere_contacts_drape_alike():
         total = np.zeros(3)
         for _ in range(30):
             net.clear_forces()
-            net.add_moving_sphere(net.segments() if segments else None, np.zeros(3),
-                                  np.zeros(3), np.zeros(3), np.zeros(3), 0.15, 1e9,
-                                  (0.005, 2e3, 0.01, 0.3, 0.01, 0.0))
+            cols = fixed_sphere(net, 0.15, np.array([0.005, 2e3, 0.01, 0.3, 0.01, 0.0]),
+                                points=not segments)
             net.advance(1 / 60)
-            total += net.impulses[0, :3]
+            total += cols.impulses[0, :3]
         return net.x, total
     xs, js = drape(True)
     xp, jp = drape(False)
@@ -210,11 +227,47 @@ def test_point_and_segment_sphere_contacts_drape_alike():
         assert np.linalg.norm(x, axis=1).min() > 0.15
 
 
-def test_point_contacts_need_an_integrator_without_jacobians():
-    net = cloth("implicit", 1e-3)
-    with pytest.raises(ParameterError, match="point contacts"):
-        net.add_moving_sphere(None, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), 0.1,
-                              1.0, (0.005, 2e3, 0.01, 0.3, 0.01, 0.0))
+def drape_on_sphere(integrator, dt, points, frames=120):
+    """A 0.3 m, 20 g cloth dropped flat onto a fixed sphere (radius 0.15 m) and left to settle
+    for frames / 60 s: (positions, the sphere's push on it (N) per 1/60 s frame)."""
+    x, t = shapes.grid(0.3, 0.3, 9, 9, origin=(-0.15, -0.15, 0.16))
+    net = SpringNetwork.from_mesh("c", x, t, 0.02, 20.0, integrator=integrator, dt=dt,
+                                  mass_damping=2.0)
+    law = np.array([0.005, 2e3, 0.5, 0.5, 0.01, 1.0])
+    push = []
+    for _ in range(frames):
+        net.clear_forces()
+        cols = fixed_sphere(net, 0.15, law, points=points)
+        net.advance(1 / 60)
+        push.append(-cols.impulses[0, 2] * 60)
+    return net.x.copy(), np.array(push)
+
+
+def test_implicit_point_contacts_drape_like_segment_contacts():
+    """The implicit network collides points too (with the law's Jacobians): the settled drape
+    matches the segment contacts' (lowest points within 1 cm of the 11 cm fall: they differ
+    as the explicit pair does, by where the cloth slides) and nothing sinks into the sphere
+    by more than 1 mm (a 2 N load on one point)."""
+    xp, _ = drape_on_sphere("implicit", 1e-3, points=True)
+    xs, _ = drape_on_sphere("implicit", 1e-3, points=False)
+    assert abs(xp[:, 2].min() - xs[:, 2].min()) < 0.01
+    assert np.linalg.norm(xp, axis=1).min() > 0.155 - 1e-3
+
+
+def test_explicit_subcycled_contact_carries_the_cloth_weight():
+    """A settled drape is carried by the sphere: its mean push over the last quarter second
+    is the cloth's weight within 2% (what is left of the drape's motion)."""
+    _, push = drape_on_sphere("explicit", 5e-5, points=True)
+    assert np.mean(push[-15:]) == pytest.approx(0.02 * 9.81, rel=0.02)
+
+
+@pytest.mark.xfail(strict=True, reason="the implicit network's sub-cycled contact reports the "
+                   "start-of-substep force as the collider's impulse while its solve applies "
+                   "the force linearised at the substep's end: a settled drape reports 2.3x "
+                   "its weight (the implicit contact of issue 22)")
+def test_implicit_subcycled_contact_carries_the_cloth_weight():
+    _, push = drape_on_sphere("implicit", 1e-3, points=True)
+    assert np.mean(push[-15:]) == pytest.approx(0.02 * 9.81, rel=0.02)
 
 
 def step_objective(net, x0, v0, **settings):
@@ -252,17 +305,17 @@ def test_objective_gradient_matches_its_finite_differences():
     u = d / np.linalg.norm(d, axis=1)[:, None]
     cn = np.einsum("ij,ij->i", u, d)
     g = np.empty((nf, 3))
-    args = (fid, net.si, net.sj, net.l0, net.k, net.tension_only, u, cn, diag, base,
-            (1 / 60) ** 2, 1 / 60 * 1e-3)
-    LG._energy_gradient(x0, *args, g)
+    obj = LG.Objective(fid, K.SpringSet(net.si, net.sj, net.l0, net.k, net.kd, net.tension_only),
+                       u, cn, diag, base, (1 / 60) ** 2, 1 / 60 * 1e-3)
+    LG._energy_gradient(x0, obj, g)
     e = 1e-6
     for p, r in [(0, 0), (3, 0), (17, 2), (nf - 1, 1)]:
         i = int(np.flatnonzero(fid == p)[0])
         xp, xm = x0.copy(), x0.copy()
         xp[i, r] += e
         xm[i, r] -= e
-        fd = (LG._energy_gradient(xp, *args, np.empty_like(g))
-              - LG._energy_gradient(xm, *args, np.empty_like(g))) / (2 * e)
+        fd = (LG._energy_gradient(xp, obj, np.empty_like(g))
+              - LG._energy_gradient(xm, obj, np.empty_like(g))) / (2 * e)
         assert abs(fd - g[p, r]) <= 1e-6 * np.abs(g).max()
 
 

@@ -18,8 +18,7 @@ def cloth_matrix(n):
     x, t = shapes.grid(1.0, 1.0, n, n)
     net = SpringNetwork.from_mesh("c", x, t, 0.15, 200.0, dt=H, integrator="localglobal",
                                   mass_damping=ALPHA, stiffness_damping=BETA, fixed=[0, n - 1])
-    _, A = LG.system_matrix(net.m, net.fixed, net.si, net.sj, net.k, net.a_idx, net.a_k,
-                            net.a_c, ALPHA, BETA, H)
+    _, A = LG.system_matrix(net.bundle(), BETA, H)
     return A.tocsr()
 
 
@@ -29,7 +28,7 @@ def preconditioner(A, **kw):
 
     def apply(b):
         out = np.empty_like(b)
-        MG.vcycle(*hier, *ws, np.ascontiguousarray(b), out)
+        MG.vcycle(hier, ws, np.ascontiguousarray(b), out)
         return out
     return apply, hier
 

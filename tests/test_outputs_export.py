@@ -35,8 +35,8 @@ def cloth_scene(n=6, duration=0.2, fps=30):
 
 @pytest.fixture(scope="module")
 def ball_result():
-    from interplay.scenes import load
-    return load("basketball").build("two-way", duration=0.4, fps=30).simulate()
+    from interplay.scenes import spec
+    return spec("basketball").build("two-way", duration=0.4, fps=30).simulate()
 
 
 @pytest.fixture(scope="module")

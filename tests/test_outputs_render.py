@@ -26,8 +26,8 @@ needs_gl = pytest.mark.skipif(not _has_gl(), reason="no headless OpenGL (EGL) co
 
 @pytest.fixture(scope="module")
 def run():
-    from interplay.scenes import load
-    return from_result(load("basketball").build("two-way", duration=0.4, fps=30).simulate())
+    from interplay.scenes import spec
+    return from_result(spec("basketball").build("two-way", duration=0.4, fps=30).simulate())
 
 
 def _read_mp4(path):

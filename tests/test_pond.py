@@ -7,14 +7,14 @@ import pytest
 from interplay import params as P
 from interplay.cli.command import main
 from interplay.errors import ParameterError
-from interplay.scenes import load
+from interplay.scenes import spec
 
 SMALL_POND = {"basin.cells": "40", "balls.count": "3"}
 
 
 def small(name, **sets):
-    m = load(name)
-    return m, P.apply(m.PARAMS(), sets)
+    m = spec(name)
+    return m, P.apply(m.params(), sets)
 
 
 @pytest.mark.parametrize("mode", ["two-way", "one-way", "hybrid"])
@@ -53,9 +53,8 @@ def test_pond_ball_count_must_match_the_lists():
 
 
 def test_pond_refuses_an_integrator():
-    m, params = small("pond")
     with pytest.raises(ParameterError, match="--integrator implicit does not apply"):
-        m.build("two-way", integrator="implicit", params=params)
+        spec("pond").check_integrator("implicit")
 
 
 def test_puddle_splashes_one_way():
@@ -63,7 +62,7 @@ def test_puddle_splashes_one_way():
     m, params = small("puddle", **{"basin.cells": "80", "clip": ""})
     scene = m.build("one-way", duration=0.6, fps=20, params=params)
     res = scene.simulate()
-    assert [p.label for p in res.passes] == ["foot", "water"]
+    assert ["+".join(p["systems"]) for p in res.passes] == ["foot", "water"]
     d = res.summary()["diagnostics"]["water"]
     assert d["peak_particles"] > 0 and d["volume_drift_rel"] < 1e-12
     foot = scene.primary
@@ -78,7 +77,7 @@ def test_the_runners_foot_splashes_the_puddle():
     m, params = small("puddle", **{"basin.cells": "80"})
     scene = m.build("one-way", duration=1.2, fps=20, params=params)
     res = scene.simulate()
-    assert [p.label for p in res.passes] == ["runner", "foot", "water"]
+    assert ["+".join(p["systems"]) for p in res.passes] == ["runner", "foot", "water"]
     runner = next(s for s in scene.systems if s.name == "runner")
     names = [s.name for s in runner.plan]
     # the foot follows the midpoint of the clip's right ankle and toes, shifted with the runner

@@ -1,4 +1,10 @@
-"""Result of a run: tracks, force logs, timings, diagnostics; summary.json and tracks.npz."""
+"""Result of a run, as data: tracks, force logs, frames, timings, diagnostics, the systems'
+descriptions and shapes; summary.json and tracks.npz.
+
+A Result holds no live system or interaction: everything the analysis, the reports, the
+compare tables and the outputs read was copied out of the scene when the run ended
+(``Result.of``), so a Result can be kept, compared and written after the scene is gone.
+"""
 from __future__ import annotations
 
 import json
@@ -13,27 +19,56 @@ from .io.atomic import atomic_path
 class Result:
     """What ``Scene.simulate()`` returns.
 
-    tracks: full-rate (x, xdot) of recorded systems; frames: per system, per output frame;
-    logs: per interaction ForceLog; passes: the scheduler's passes with their wall times.
+    scene: the scene's name; coupling, duration (s), fps, primary (name or None), main (the
+    main interaction's name or None); systems, interactions: their ``describe()``; shapes:
+    every system's Shapes; checkpoints: {system: times (s)}; meta: the scene's metadata;
+    passes: each pass's ``describe()``; logs: {interaction: ForceLog}; tracks: {system: Track}
+    (full-rate (x, xdot) of recorded systems); frames: {system: {key: (f, ...)}} per output
+    frame; warnings; diagnostics: {system: {...}} (energy, lowest point, strain, the system's
+    own); total_s: wall time (s).
     """
 
-    def __init__(self, scene, passes, logs, tracks, frames, warnings, monitors, initial_ke,
+    def __init__(self, scene, coupling, duration, fps, primary, main, systems, interactions,
+                 shapes, checkpoints, meta, passes, logs, tracks, frames, warnings, diagnostics,
                  total_s):
-        self.scene = scene
-        self.passes = passes
-        self.logs = logs
-        self.tracks = tracks
-        self.frames = frames
-        self.warnings = warnings
-        self.monitors = monitors
-        self.initial_ke = initial_ke
-        self.total_s = total_s
+        self.scene, self.coupling, self.duration, self.fps = scene, coupling, duration, fps
+        self.primary, self.main = primary, main
+        self.systems, self.interactions, self.shapes = systems, interactions, shapes
+        self.checkpoint_times, self.meta = checkpoints, meta
+        self.passes, self.logs, self.tracks, self.frames = passes, logs, tracks, frames
+        self.warnings, self.diagnostics, self.total_s = warnings, diagnostics, total_s
+
+    @classmethod
+    def of(cls, scene, passes, logs, tracks, frames, warnings, monitors, initial_ke, total_s):
+        """Copy what a finished run of ``scene`` produced out of its live objects."""
+        main = scene.main_interaction
+        shapes = [sh for s in scene.systems for sh in s.shapes()]
+        return cls(scene.name, scene.coupling, float(scene.duration), float(scene.fps),
+                   scene.primary.name if scene.primary is not None else None,
+                   main.name if main is not None else None,
+                   [s.describe() for s in scene.systems],
+                   [it.describe() for it in scene.interactions], shapes,
+                   {k: list(v) for k, v in scene.checkpoints.items()}, dict(scene.meta),
+                   [p.describe() for p in passes], logs, tracks, frames, list(warnings),
+                   _diagnostics(scene.systems, monitors, initial_ke, warnings), total_s)
+
+    # --- lookups -----------------------------------------------------------------------------
+    def interaction(self, name: str) -> dict:
+        """The description of the interaction called ``name``."""
+        return next(it for it in self.interactions if it["name"] == name)
+
+    def system(self, name: str) -> dict:
+        """The description of the system called ``name``."""
+        return next(s for s in self.systems if s["name"] == name)
+
+    @property
+    def main_interaction(self) -> dict | None:
+        return None if self.main is None else self.interaction(self.main)
 
     # --- timings ---------------------------------------------------------------------------
     def _primary_pass_index(self) -> int:
-        prim = self.scene.primary
         for i, p in enumerate(self.passes):
-            if prim is not None and prim in p.live:
+            if self.primary is not None and self.primary in p["systems"]:
                 return i
         return len(self.passes) - 1
 
@@ -41,16 +76,13 @@ class Result:
     def primary_cycle_s(self) -> float:
         """Primary debug-cycle time: wall time (s) until the primary's motion is complete."""
         i = self._primary_pass_index()
-        return float(sum(p.wall_s for p in self.passes[: i + 1]))
+        return float(sum(p["wall_s"] for p in self.passes[: i + 1]))
 
     def timings(self) -> dict:
         prim = self.primary_cycle_s
         return {"primary_pass_s": prim,
-                "secondary_pass_s": float(sum(p.wall_s for p in self.passes)) - prim,
-                "total_s": float(self.total_s),
-                "passes": [{"systems": [s.name for s in p.live], "played": [s.name for s in p.played],
-                            "wall_s": p.wall_s, "steps": p.steps, "coupling_dt_s": p.h}
-                           for p in self.passes]}
+                "secondary_pass_s": float(sum(p["wall_s"] for p in self.passes)) - prim,
+                "total_s": float(self.total_s), "passes": self.passes}
 
     # --- states ----------------------------------------------------------------------------
     def state_at(self, system: str, t: float):
@@ -59,11 +91,11 @@ class Result:
 
     def checkpoints(self) -> list[dict]:
         out = []
-        for name, times in self.scene.checkpoints.items():
+        for name, times in self.checkpoint_times.items():
             if name not in self.tracks:
                 continue
             for t in times:
-                if t <= self.scene.duration:
+                if t <= self.duration:
                     x, v = self.state_at(name, t)
                     out.append({"system": name, "t": t, "position": x[:3].tolist(),
                                 "velocity": v[:3].tolist()})
@@ -71,46 +103,25 @@ class Result:
 
     # --- analysis --------------------------------------------------------------------------
     def interaction_stats(self) -> list[dict]:
-        return [interaction_stats(self.logs[it.name]) for it in self.scene.interactions]
+        return [interaction_stats(self.logs[it["name"]]) for it in self.interactions]
 
     def advice(self, one_way_stable=None, two_way_cost_s=None) -> dict:
-        """The advisor's verdict for the scene's main interaction (Scene.main_interaction)."""
-        it = self.scene.main_interaction
+        """The advisor's verdict for the scene's main interaction."""
+        it = self.main_interaction
         if it is None:
-            return {"mode": None, "reasons": ["no interaction acts on a dynamic system"]}
-        if one_way_stable is None and it.mode != "two-way":
-            one_way_stable = not any(it.secondary.name in w for w in self.warnings)
-        if two_way_cost_s is None and it.mode == "two-way":
+            return {"mode": None, "reasons": ["no interaction acts on a moving system"]}
+        if one_way_stable is None and it["mode"] != "two-way":
+            one_way_stable = not any(it["secondary"] in w for w in self.warnings)
+        if two_way_cost_s is None and it["mode"] == "two-way":
             two_way_cost_s = self.total_s
-        return advise(interaction_stats(self.logs[it.name]), it, one_way_stable, two_way_cost_s)
-
-    def diagnostics(self) -> dict:
-        out = {}
-        for s in self.scene.systems:
-            if not s.dynamic or s.name not in self.monitors:
-                continue
-            mon = self.monitors[s.name]
-            ke = mon.ke[s.name]
-            d = {"kinetic_energy_J": {"initial": float(self.initial_ke[s.name]),
-                                      "max": float(max(ke)), "final": float(ke[-1])},
-                 "lowest_z_m": float(min(mon.lowest[s.name])) if mon.lowest[s.name] else None,
-                 "instability": [w for w in self.warnings if w.startswith(s.name + ":")]}
-            if s.name in mon.strain:
-                d["max_strain"] = float(max(mon.strain[s.name], default=0.0))
-            d.update(s.extra_diagnostics())
-            out[s.name] = d
-        return out
+        return advise(interaction_stats(self.logs[it["name"]]), it, one_way_stable,
+                      two_way_cost_s)
 
     def summary(self, **advice_kw) -> dict:
-        sc = self.scene
-        return {"scene": sc.name, "coupling": sc.coupling, "duration_s": sc.duration,
-                "fps": sc.fps,
-                "systems": [s.describe() for s in sc.systems],
-                "timings": self.timings(),
-                "interactions": self.interaction_stats(),
-                "advice": self.advice(**advice_kw),
-                "diagnostics": self.diagnostics(),
-                "primary_checkpoints": self.checkpoints(),
+        return {"scene": self.scene, "coupling": self.coupling, "duration_s": self.duration,
+                "fps": self.fps, "systems": self.systems, "timings": self.timings(),
+                "interactions": self.interaction_stats(), "advice": self.advice(**advice_kw),
+                "diagnostics": self.diagnostics, "primary_checkpoints": self.checkpoints(),
                 "warnings": list(self.warnings)}
 
     # --- files -----------------------------------------------------------------------------
@@ -134,6 +145,26 @@ class Result:
             with open(tmp, "wb") as fh:
                 np.savez_compressed(fh, **arrays)
         return paths
+
+
+def _diagnostics(systems, monitors, initial_ke, warnings) -> dict:
+    """Per moving system: kinetic energy (initial, max, final), lowest point, instabilities,
+    largest strain, and the system's own extra diagnostics."""
+    out = {}
+    for s in systems:
+        if s.name not in monitors:
+            continue
+        mon = monitors[s.name]
+        ke = mon.ke[s.name]
+        d = {"kinetic_energy_J": {"initial": float(initial_ke[s.name]),
+                                  "max": float(max(ke)), "final": float(ke[-1])},
+             "lowest_z_m": float(min(mon.lowest[s.name])) if mon.lowest[s.name] else None,
+             "instability": [w for w in warnings if w.startswith(s.name + ":")]}
+        if mon.strain[s.name]:
+            d["max_strain"] = float(max(mon.strain[s.name]))
+        d.update(s.extra_diagnostics())
+        out[s.name] = d
+    return out
 
 
 def _json_default(o):

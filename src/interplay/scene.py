@@ -3,10 +3,11 @@ from __future__ import annotations
 
 import time as wallclock
 
+from .coupling.forcelog import ForceLog
+from .coupling.modes import MODES
 from .coupling.scheduler import as_array_frames, plan, run_passes
 from .errors import SceneError, require_positive
-from .coupling.forcelog import ForceLog
-from .interactions.base import MODES
+from .systems.base import Role
 
 
 class Scene:
@@ -14,7 +15,10 @@ class Scene:
 
     duration: simulated time (s); fps: output frames per second; coupling_dt: the step (s) at
     which interactions exchange forces (default: each pass's smallest system dt); primary: the
-    system whose motion the animator tunes (its pass time is the primary debug-cycle time).
+    system whose motion the animator tunes (its pass time is the primary debug-cycle time);
+    main: the name of the interaction Table I and the advisor are about (default: the first
+    between two moving systems, else the first acting on a moving system); checkpoints:
+    {system name: times (s)} at which the summary reports its state.
     """
 
     def __init__(self, name: str, duration: float = 1.5, fps: float = 60.0,
@@ -27,6 +31,7 @@ class Scene:
         self.systems: list = []
         self.interactions: list = []
         self.primary = None
+        self.main: str | None = None
         self.checkpoints: dict[str, list[float]] = {}
         self.meta: dict = {}
 
@@ -47,34 +52,39 @@ class Scene:
         return interaction
 
     def set_coupling(self, mode: str):
-        """Set every interaction between two dynamic systems to ``mode``."""
+        """Set every interaction between two moving (non-static) systems to ``mode``."""
         if mode not in MODES:
             raise SceneError(f"unknown coupling {mode!r}; choose one of {', '.join(MODES)}")
         for it in self.interactions:
-            if it.primary.dynamic and it.secondary.dynamic:
+            if it.primary.role is not Role.STATIC and it.secondary.role is not Role.STATIC:
                 it.mode = mode
 
     @property
     def coupling(self) -> str:
-        """The scene's coupling mode: that of every interaction acting on a dynamic secondary,
-        counted as one-way when the primary is prescribed (nothing can push back on it)."""
-        modes = sorted({it.effective_mode for it in self.interactions if it.secondary.dynamic})
+        """The scene's coupling mode: that of every interaction acting on a moving secondary,
+        counted as one-way when the primary is not dynamic (nothing can push back on it)."""
+        modes = sorted({it.effective_mode for it in self.interactions
+                        if it.secondary.role is not Role.STATIC})
         return modes[0] if len(modes) == 1 else ("mixed" if modes else "none")
 
     @property
     def main_interaction(self):
-        """The interaction Table I and the advisor are about: the first between two dynamic
-        systems, else the first driving a dynamic secondary from a moving primary (a wind)."""
-        for it in self.interactions:
-            if it.primary.dynamic and it.secondary.dynamic:
+        """The interaction Table I and the advisor are about (see ``main``)."""
+        if self.main is not None:
+            for it in self.interactions:
+                if it.name == self.main:
+                    return it
+            raise SceneError(f"scene {self.name}: main interaction {self.main!r} is not one of "
+                             f"{', '.join(it.name for it in self.interactions)}")
+        moving = [it for it in self.interactions if it.secondary.role is not Role.STATIC]
+        for it in moving:
+            if it.primary.role is not Role.STATIC:
                 return it
-        for it in self.interactions:
-            if it.secondary.dynamic and it.primary.kind != "static":
-                return it
-        return None
+        return moving[0] if moving else None
 
     def simulate(self, progress=None, refine_unstable: bool = True, primary_only: bool = False):
-        """Run all passes and return a Result (tracks, force logs, timings, diagnostics).
+        """Run all passes and return a Result (tracks, force logs, timings, diagnostics, the
+        systems' shapes: data only, no live object).
 
         primary_only: stop after the pass that contains the primary (the animator's fast
         preview of the primary under one-way or hybrid coupling)."""
@@ -90,5 +100,5 @@ class Scene:
         tracks, frames, warnings, monitors = run_passes(
             passes, self.duration, self.fps, self.coupling_dt, logs, progress, refine_unstable)
         total = wallclock.perf_counter() - t0
-        return Result(self, passes, logs, tracks, as_array_frames(frames), warnings, monitors,
-                      initial_ke, total)
+        return Result.of(self, passes, logs, tracks, as_array_frames(frames), warnings,
+                         monitors, initial_ke, total)

@@ -5,16 +5,18 @@ from __future__ import annotations
 G = 9.81  # m/s^2, the reference acceleration a primary already feels
 
 
-def advise(stats: dict, interaction, one_way_stable: bool | None = None,
+def advise(stats: dict, interaction: dict, one_way_stable: bool | None = None,
            two_way_cost_s: float | None = None, cost_budget_s: float = 60.0,
            significant_fraction: float = 0.1) -> dict:
     """The decision tree of the paper's Figure 17, with the measured reasons.
 
-    significant: mean effective acceleration over contact >= significant_fraction * g.
+    interaction: its ``describe()`` (the primary's role, the stand-in, whether two-way is
+    implemented); significant: mean effective acceleration over contact >=
+    significant_fraction * g.
     one_way_stable: whether a one-way run of the secondary stayed stable (None: not measured).
     two_way_cost_s: wall time of a two-way run (None: not measured); expensive above the budget.
     """
-    if not (interaction.primary.dynamic and interaction.primary.accepts_forces):
+    if interaction["primary_role"] != "dynamic":
         return {"mode": "one-way", "reasons": [
             f"{stats['primary']} is prescribed (animation, motion capture or a field): nothing "
             "can push back on it, so only one-way coupling applies"]}
@@ -35,7 +37,7 @@ def advise(stats: dict, interaction, one_way_stable: bool | None = None,
     else:
         reasons.append(f"at or above {100 * significant_fraction:.0f}% of g: the interaction "
                        "significantly affects the primary")
-    supported = getattr(interaction, "two_way_supported", True)
+    supported = interaction["two_way_supported"]
     expensive = two_way_cost_s is not None and two_way_cost_s > cost_budget_s
     if two_way_cost_s is not None:
         reasons.append(f"a two-way run took {two_way_cost_s:.2f} s of wall time (budget "
@@ -43,9 +45,9 @@ def advise(stats: dict, interaction, one_way_stable: bool | None = None,
     if supported and not expensive:
         reasons.append("two-way coupling is implemented and affordable")
         return {"mode": "two-way", "reasons": reasons}
-    if interaction.standin is not None:
+    if interaction["standin"] is not None:
         reasons.append(f"two-way is {'too expensive' if expensive else 'not implemented'}; "
-                       f"a stand-in ({interaction.standin.name}) is available")
+                       f"a stand-in ({interaction['standin']}) is available")
         return {"mode": "hybrid", "reasons": reasons}
     reasons.append("no stand-in is available: no good compromise (potential problem)")
     return {"mode": "problem", "reasons": reasons}

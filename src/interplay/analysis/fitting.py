@@ -2,7 +2,7 @@
 
 The stand-in is a damping field: it can slow the primary and its spin, not turn them. So the
 linear coefficient is chosen (by Brent's method) so that the primary, simulated alone with the
-stand-in (the hybrid primary pass), has the two-way primary's *speed* at the scene's FIT_TIME;
+stand-in (the hybrid primary pass), has the two-way primary's *speed* at the spec's fit_time;
 the angular coefficient likewise matches the spin rate when the primary enters spinning (a
 damping field cannot create spin, so otherwise it is left as given). The report gives the
 remaining difference in direction, which only the full interaction reproduces.
@@ -35,25 +35,28 @@ def _match(fn, target, hi=1.0, grow=4.0, tries=12):
     return hi
 
 
-def fit_standin(module, params=None, reference=None, **build_kw) -> dict:
-    """Fit the stand-in coefficients of ``module``'s scene; returns the fit and its report.
+def fit_standin(spec, params=None, reference=None, **build_kw) -> dict:
+    """Fit the stand-in coefficients of a scene (its SceneSpec: ``standin``, ``fit_time``);
+    returns the fit and its report.
 
     reference: a two-way Result to fit to (run here if None).
     """
-    params = params if params is not None else module.PARAMS()
+    spec.check_fit()
+    params = params if params is not None else spec.params()
+    fit_time = spec.fit_time
     if reference is None:
-        reference = module.build("two-way", params=params, **build_kw).simulate()
-    name = reference.scene.primary.name
-    v_ref, w_ref = _velocities(reference, name, module.FIT_TIME)
-    field = getattr(params, module.STANDIN)
+        reference = spec.build("two-way", params=params, **build_kw).simulate()
+    name = reference.primary
+    v_ref, w_ref = _velocities(reference, name, fit_time)
+    field = getattr(params, spec.standin)
     runs = []
 
     def hybrid(linear, angular):
-        p = dataclasses.replace(params, **{module.STANDIN: dataclasses.replace(
+        p = dataclasses.replace(params, **{spec.standin: dataclasses.replace(
             field, linear=float(linear), angular=float(angular), enabled=True)})
-        r = module.build("hybrid", params=p, **build_kw).simulate(primary_only=True)
+        r = spec.build("hybrid", params=p, **build_kw).simulate(primary_only=True)
         runs.append(r.primary_cycle_s)
-        return _velocities(r, name, module.FIT_TIME)
+        return _velocities(r, name, fit_time)
 
     linear = _match(lambda c: np.linalg.norm(hybrid(c, field.angular)[0]),
                     float(np.linalg.norm(v_ref)))
@@ -68,7 +71,7 @@ def fit_standin(module, params=None, reference=None, **build_kw) -> dict:
                      "angular coefficient is left as given")
     v_fit, w_fit = hybrid(linear, angular)
     cos = float(v_fit @ v_ref / (np.linalg.norm(v_fit) * np.linalg.norm(v_ref)))
-    return {"linear": float(linear), "angular": float(angular), "fit_time_s": module.FIT_TIME,
+    return {"linear": float(linear), "angular": float(angular), "fit_time_s": fit_time,
             "two_way_velocity": v_ref.tolist(), "hybrid_velocity": v_fit.tolist(),
             "two_way_spin": w_ref.tolist(), "hybrid_spin": w_fit.tolist(),
             "speed_error_rel": float(abs(np.linalg.norm(v_fit) - np.linalg.norm(v_ref))

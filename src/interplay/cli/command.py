@@ -11,8 +11,6 @@ from pathlib import Path
 
 from ..errors import InterplayError, ParameterError
 
-MODES = ("two-way", "one-way", "hybrid")
-
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, not usage + traceback
@@ -22,8 +20,10 @@ class _Parser(argparse.ArgumentParser):
 
 def _scene_options(p):
     p.add_argument("scene", help="scene name (see `interplay list`)")
-    p.add_argument("--duration", type=float, default=None, help="simulated seconds")
-    p.add_argument("--fps", type=float, default=60.0, help="output frames per second")
+    p.add_argument("--duration", type=float, default=None,
+                   help="simulated seconds (default: the scene's)")
+    p.add_argument("--fps", type=float, default=None,
+                   help="output frames per second (default: the scene's)")
     p.add_argument("--integrator", default=None,
                    help="explicit | implicit | localglobal (spring-mass systems)")
     p.add_argument("--dt", type=float, default=None, help="spring-mass step in seconds")
@@ -45,8 +45,9 @@ def _output_options(p):
         g.add_argument(f"--no-{name}", action="store_true", help=f"skip the {name} output")
 
 
-def _outputs(args):
-    """OutputOptions from the command line (checked before any simulation runs)."""
+def _outputs(args, spec=None):
+    """OutputOptions from the command line (checked before any simulation runs); the scene's
+    own camera unless --camera is given."""
     from ..outputs.writer import OutputOptions
     from ..outputs.render.camera import parse_camera
     w, x, h = args.size.lower().partition("x")
@@ -59,7 +60,8 @@ def _outputs(args):
     return OutputOptions(usd=not args.no_usd, usd_format="usda" if args.usda else "usdc",
                          obj=not args.no_obj, video=not args.no_video, report=not args.no_report,
                          size=size, video_fps=args.video_fps,
-                         camera=parse_camera(args.camera) if args.camera else None,
+                         camera=(parse_camera(args.camera) if args.camera
+                                 else spec.camera if spec is not None else None),
                          quiet=args.quiet)
 
 
@@ -85,59 +87,57 @@ def _parser():
 
 
 def _build_kwargs(args):
+    """(the scene's SceneSpec, the build keywords) from the command line, every value checked
+    against the spec before anything runs."""
     from .. import params as P
-    from ..scenes import load
-    module = load(args.scene)
+    from ..scenes import spec as scene_spec
+    spec = scene_spec(args.scene)
     assignments = {}
     for item in args.sets:
         key, eq, value = item.partition("=")
         if not eq or not key:
             raise ParameterError(f"--set {item}: expected KEY=VALUE")
         assignments[key.strip()] = value.strip()
-    kw = {"params": P.apply(module.PARAMS(), assignments), "fps": args.fps}
-    if args.duration is not None:
-        kw["duration"] = args.duration
-    if args.integrator is not None:
-        from ..systems.springmass import INTEGRATORS
-        if args.integrator not in INTEGRATORS:
-            raise ParameterError(f"--integrator {args.integrator}: choose one of "
-                                 f"{', '.join(INTEGRATORS)}")
-        kw["integrator"] = args.integrator
+    kw = {"params": P.apply(spec.params(), assignments), "fps": args.fps or spec.fps,
+          "duration": args.duration if args.duration is not None else spec.duration}
+    integrator = spec.check_integrator(args.integrator)
+    if integrator is not None:
+        kw["integrator"] = integrator
     if args.dt is not None:
         kw["dt"] = args.dt
-    return module, kw
+    return spec, kw
 
 
-def _check_mode(mode):
-    if mode is not None and mode not in MODES:
-        raise ParameterError(f"--coupling {mode}: unknown coupling; choose one of "
-                             f"{', '.join(MODES)}")
-
-
-def _run_one(module, mode, kw, out, quiet, console, options=None):
+def run_scene(spec, mode, kw, quiet=True):
+    """Build and simulate one scene in one coupling mode (checked against its spec)."""
     from .progress import PassProgress
-    scene = module.build(mode, **kw) if mode else module.build(**kw)
-    result = scene.simulate(progress=PassProgress(scene.duration, quiet))
-    if options is None:
-        return result, result.save(out)
-    from ..outputs.writer import write_outputs
-    return result, write_outputs(result, out, options)
+    scene = spec.build(spec.check_coupling(mode), **kw)
+    return scene.simulate(progress=PassProgress(scene.duration, quiet))
+
+
+def scene_summary(spec, result, **advice_kw) -> dict:
+    """summary.json: the generic summary plus the scene's own key figures."""
+    summary = result.summary(**advice_kw)
+    if spec.figures is not None:
+        summary["figures"] = spec.figures(result)
+    return summary
 
 
 def cmd_list(args, console):
-    from ..scenes import REGISTRY
-    for name, (_, text) in sorted(REGISTRY.items()):
-        console.print(f"[bold]{name}[/bold]  {text}")
+    from ..scenes import all_specs
+    for spec in all_specs():
+        console.print(f"[bold]{spec.name}[/bold]  {spec.description}")
 
 
 def cmd_run(args, console):
-    _check_mode(args.coupling)
-    module, kw = _build_kwargs(args)
+    spec, kw = _build_kwargs(args)
+    mode = spec.check_coupling(args.coupling)
     out = Path(args.out or f"out/{args.scene}")
-    options = _outputs(args)
-    from ..outputs.writer import preflight
+    options = _outputs(args, spec)
+    from ..outputs.writer import preflight, write_outputs
     preflight(out, options)
-    result, paths = _run_one(module, args.coupling, kw, out, args.quiet, console, options)
+    result = run_scene(spec, mode, kw, args.quiet)
+    paths = write_outputs(result, out, options, scene_summary(spec, result))
     from .text import print_run
     print_run(console, result)
     for p in paths:
@@ -146,22 +146,22 @@ def cmd_run(args, console):
 
 def cmd_compare(args, console):
     from .compare import compare_modes
-    module, kw = _build_kwargs(args)
+    spec, kw = _build_kwargs(args)
+    spec.check_compare()
     out = Path(args.out or f"out/{args.scene}")
-    compare_modes(module, kw, out, args.quiet, console, _outputs(args))
+    compare_modes(spec, kw, out, args.quiet, console, _outputs(args, spec))
 
 
 def cmd_fit(args, console):
     from ..analysis.fitting import fit_standin
     from ..io.atomic import atomic_path
-    module, kw = _build_kwargs(args)
-    if not hasattr(module, "STANDIN"):
-        raise ParameterError(f"scene {args.scene} has no hybrid stand-in to fit")
+    spec, kw = _build_kwargs(args)
+    spec.check_fit()
     params = kw.pop("params")
     console.print("running the two-way reference, then fitting the stand-in ...")
-    fit = fit_standin(module, params, **kw)
-    console.print(f"fitted {module.STANDIN}.linear = {fit['linear']:.6g} N s/m, "
-                  f"{module.STANDIN}.angular = {fit['angular']:.6g} N m s")
+    fit = fit_standin(spec, params, **kw)
+    console.print(f"fitted {spec.standin}.linear = {fit['linear']:.6g} N s/m, "
+                  f"{spec.standin}.angular = {fit['angular']:.6g} N m s")
     console.print(f"velocity at t={fit['fit_time_s']} s: two-way "
                   f"{_vec(fit['two_way_velocity'])} m/s, hybrid {_vec(fit['hybrid_velocity'])} "
                   f"m/s: speed error {100 * fit['speed_error_rel']:.2f}%, direction off by "

@@ -1,43 +1,44 @@
-"""`interplay compare`: the three coupling modes side by side (the paper's Figure 2)."""
+"""`interplay compare`: the coupling modes a scene supports, side by side (the paper's Figure 2)."""
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
 from ..io.atomic import atomic_path
-from .progress import PassProgress
 from .text import mode_row
 
-MODES = ("two-way", "one-way", "hybrid")
 
-
-def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> dict:
-    """Run every mode, save each under out/MODE, print one table, write out/compare.json.
+def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> dict:
+    """Run every coupling the scene's spec supports, save each under out/MODE, print one
+    table, write out/compare.json.
 
     options: an outputs.OutputOptions to also write each mode's USD, OBJ, video and report,
     and the side-by-side video and compare report in out (None: summary and tracks only)."""
+    from .command import run_scene, scene_summary
     if options is not None:
         from ..outputs.writer import preflight
         preflight(out, options)
     results = {}
-    for mode in MODES:
+    for mode in spec.couplings:
         if not quiet:
             console.print(f"[bold]{mode}[/bold] ...")
-        scene = module.build(mode, **kw)
-        results[mode] = scene.simulate(progress=PassProgress(scene.duration, quiet))
-    one_way_stable = not any(results["one-way"].warnings)
-    two_way_cost = results["two-way"].total_s
+        results[mode] = run_scene(spec, mode, kw, quiet)
+    reference = results.get("two-way")
+    one_way_stable = (not any(results["one-way"].warnings)) if "one-way" in results else None
+    two_way_cost = reference.total_s if reference is not None else None
     rows, paths = {}, []
     for mode, r in results.items():
-        summary = r.summary(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
+        summary = scene_summary(spec, r, one_way_stable=one_way_stable,
+                                two_way_cost_s=two_way_cost)
         if options is None:
             paths += r.save(out / mode, summary)
         else:
             from ..outputs.writer import write_outputs
             paths += write_outputs(r, out / mode, options, summary)
-        rows[mode] = mode_row(r)
-    advice = results["two-way"].advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
-    report = {"scene": results["two-way"].scene.name, "modes": rows, "advice": advice}
+        rows[mode] = mode_row(r, summary.get("figures", {}))
+    first = reference or next(iter(results.values()))
+    advice = first.advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
+    report = {"scene": spec.name, "modes": rows, "advice": advice}
     path = out / "compare.json"
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(report, indent=2))
@@ -51,6 +52,12 @@ def compare_modes(module, kw, out: Path, quiet: bool, console, options=None) -> 
     return report
 
 
+def _figure(value) -> str:
+    if isinstance(value, (list, tuple)):
+        return ", ".join(f"{v:.2f}" for v in value)
+    return f"{value:.3f}"
+
+
 def _print_table(console, rows, advice):
     from rich.table import Table
     table = Table(title="coupling modes side by side")
@@ -60,11 +67,9 @@ def _print_table(console, rows, advice):
     def line(label, fn):
         table.add_row(label, *(fn(r) for r in rows.values()))
 
-    line("exit speed (m/s)", lambda r: f"{r['exit_speed']:.3f}" if "exit_speed" in r else "-")
-    line("free-flight speed then (m/s)",
-         lambda r: f"{r['free_flight_exit_speed']:.3f}" if "exit_speed" in r else "-")
-    line("exit velocity (m/s)", lambda r: ", ".join(f"{v:.2f}" for v in r["exit_velocity"])
-         if "exit_velocity" in r else "-")
+    labels = list(dict.fromkeys(k for r in rows.values() for k in r["figures"]))
+    for label in labels:
+        line(label, lambda r, k=label: _figure(r["figures"][k]) if k in r["figures"] else "-")
     line("max secondary strain", lambda r: f"{100 * r['max_strain']:.1f}%"
          if r["max_strain"] is not None else "-")
     line("force min/max/mean (N)", lambda r: "{min:.1f}/{max:.1f}/{mean:.1f}".format(**r["force_N"]))

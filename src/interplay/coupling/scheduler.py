@@ -4,7 +4,8 @@
 * For one-way and hybrid interactions the primary's group runs first (hybrid: with the
   stand-in acting on the primary) and its motion is recorded as a track; the secondary's group
   runs afterwards with the primary *played back* from that track (cubic Hermite).
-* Static systems (the floor) join no group; any pass may use them.
+* Static systems (the floor, the wind) join no group; any pass may use them. Prescribed
+  systems (animation) run in passes of their own like dynamic ones, but nothing pushes them.
 
 Within a pass the coupling step h is the scene's ``coupling_dt`` or else the smallest ``dt`` of
 the pass's systems. At each coupling step every interaction is evaluated once from the current
@@ -12,6 +13,9 @@ states and its forces are held constant while each system advances h in ceil(h/d
 an interaction may instead defer (``exchange`` returns None): its secondary advances first,
 integrating the interaction at every substep inside its kernel, and ``complete`` hands the
 primary the step's mean force before the primary advances.
+
+The scheduler never changes a system: a pass holds its own table of largest substeps (each
+system's ``dt`` unless an instability made it rerun at a smaller one, which is reported).
 """
 from __future__ import annotations
 
@@ -21,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SceneError, StabilityError
+from ..systems.base import Role
 from .forcelog import ForceLog
 from .track import Track, TrackRecorder
 
@@ -38,16 +43,26 @@ class Pass:
     wall_s: float = 0.0
     steps: int = 0
     h: float = 0.0
-    contains_primary: bool = False
+    dts: dict = field(default_factory=dict)      # system name -> largest substep (s)
 
     @property
     def label(self) -> str:
         return "+".join(s.name for s in self.live)
 
+    def describe(self) -> dict:
+        """The pass as data (summary.json's timings)."""
+        return {"systems": [s.name for s in self.live], "played": [s.name for s in self.played],
+                "wall_s": self.wall_s, "steps": self.steps, "coupling_dt_s": self.h,
+                "substep_s": dict(self.dts)}
+
+
+def _moving(s) -> bool:
+    return s.role is not Role.STATIC
+
 
 def plan(systems, interactions) -> list[Pass]:
     """Order the scene into passes; raise SceneError on a contradictory coupling graph."""
-    dynamic = [s for s in systems if s.dynamic]
+    dynamic = [s for s in systems if _moving(s)]
     parent = {s.name: s.name for s in dynamic}
 
     def root(n):
@@ -58,7 +73,7 @@ def plan(systems, interactions) -> list[Pass]:
 
     for it in interactions:
         a, b = it.primary, it.secondary
-        if it.mode == "two-way" and a.dynamic and b.dynamic:
+        if it.mode == "two-way" and _moving(a) and _moving(b):
             parent[root(a.name)] = root(b.name)
     groups: dict[str, list] = {}
     for s in dynamic:
@@ -66,7 +81,7 @@ def plan(systems, interactions) -> list[Pass]:
     # one-way/hybrid edges: the primary's group must run before the secondary's
     after: dict[str, set] = {g: set() for g in groups}
     for it in interactions:
-        if it.mode == "two-way" or not (it.primary.dynamic and it.secondary.dynamic):
+        if it.mode == "two-way" or not (_moving(it.primary) and _moving(it.secondary)):
             continue
         ga, gb = root(it.primary.name), root(it.secondary.name)
         if ga == gb:
@@ -86,19 +101,19 @@ def plan(systems, interactions) -> list[Pass]:
             done.add(g)
     passes, earlier = [], set()
     needed_later = {it.primary.name for it in interactions
-                    if it.mode != "two-way" and it.primary.dynamic and it.secondary.dynamic}
+                    if it.mode != "two-way" and _moving(it.primary) and _moving(it.secondary)}
     for g in order:
         live = groups[g]
         names = {s.name for s in live}
-        p = Pass(live=live)
+        p = Pass(live=live, dts={s.name: s.dt for s in live})
         for it in interactions:
             a, b = it.primary.name, it.secondary.name
             if it.mode == "two-way":
                 if a in names or b in names:
                     p.actions.append((it, "both"))
-            elif b in names and (a in earlier or not it.primary.dynamic):
+            elif b in names and (a in earlier or not _moving(it.primary)):
                 p.actions.append((it, "secondary"))
-                if it.primary.dynamic and it.primary not in p.played:
+                if _moving(it.primary) and it.primary not in p.played:
                     p.played.append(it.primary)
             elif a in names and it.mode == "hybrid":
                 p.actions.append((it, "standin"))
@@ -121,16 +136,17 @@ class Monitor:
     def __init__(self, systems):
         self.ke = {s.name: [s.kinetic_energy()] for s in systems}
         self.lowest = {s.name: [] for s in systems}
-        self.strain = {s.name: [] for s in systems if hasattr(s, "strain")}
+        self.strain = {s.name: [] for s in systems}
 
     def sample(self, systems):
         for s in systems:
             self.ke[s.name].append(s.kinetic_energy())
-            z = s.lowest_z() if hasattr(s, "lowest_z") else None
+            z = s.lowest_z()
             if z is not None:
                 self.lowest[s.name].append(z)
-            if s.name in self.strain:
-                self.strain[s.name].append(s.strain())
+            e = s.strain()
+            if e is not None:
+                self.strain[s.name].append(e)
 
 
 def run_pass(p: Pass, duration, h, fps, logs, tracks, frames, monitor, progress=None):
@@ -157,8 +173,9 @@ def run_pass(p: Pass, duration, h, fps, logs, tracks, frames, monitor, progress=
     actions = [(it, role, logs[it.name] if role != "standin" else logs[it.name].standin)
                for it, role in p.actions]
     for it, role in p.actions:
-        it.prepare(h)
+        it.prepare(h, p.dts)
     deferred = []
+    dts = p.dts
     t0 = wallclock.perf_counter()
     for k in range(n + 1):
         t = k * h
@@ -189,16 +206,16 @@ def run_pass(p: Pass, duration, h, fps, logs, tracks, frames, monitor, progress=
             waiting = {it.primary.name for it, _, _ in deferred}
             for s in live:
                 if s.name not in waiting:
-                    s.advance(h)
+                    s.advance(h, dts[s.name])
             for it, role, log in deferred:
                 log.record(t, *it.complete(role == "both"))
             for s in live:
                 if s.name in waiting:
-                    s.advance(h)
+                    s.advance(h, dts[s.name])
             deferred.clear()
         else:
             for s in live:
-                s.advance(h)
+                s.advance(h, dts[s.name])
         for s, r in zip(p.record, recs):
             r.record(t + h, *s.generalized_state())
         if (k + 1) % check_every == 0:
@@ -221,8 +238,9 @@ def run_pass(p: Pass, duration, h, fps, logs, tracks, frames, monitor, progress=
 def run_passes(passes, duration, fps, coupling_dt, logs, progress=None, refine_unstable=True,
                max_refinements=2):
     """Run every pass in order. An unstable pass is rerun from its start with the offending
-    system's step divided by 10 (up to ``max_refinements`` times), each rerun reported in the
-    returned warnings; past that a StabilityError says what blew up and what to try."""
+    system's largest substep divided by 10 (in the pass's own step table, up to
+    ``max_refinements`` times), each rerun reported in the returned warnings; past that a
+    StabilityError says what blew up and what to try."""
     tracks: dict[str, Track] = {}
     frames: dict[str, dict] = {}
     warnings: list[str] = []
@@ -230,7 +248,7 @@ def run_passes(passes, duration, fps, coupling_dt, logs, progress=None, refine_u
     for p in passes:
         snaps = {s.name: s.capture() for s in p.live}
         for attempt in range(max_refinements + 1):
-            h = coupling_dt or min(s.dt for s in p.live)
+            h = coupling_dt or min(p.dts.values())
             monitor = Monitor(p.live)
             try:
                 run_pass(p, duration, h, fps, logs, tracks, frames, monitor, progress)
@@ -243,10 +261,10 @@ def run_passes(passes, duration, fps, coupling_dt, logs, progress=None, refine_u
                 if not refine_unstable or attempt == max_refinements:
                     raise StabilityError(
                         f"{e}; try a smaller --dt for {e.system.name} or --integrator implicit")
-                old = e.system.dt
-                e.system.dt = old / 10.0
+                old = p.dts[e.system.name]
+                p.dts[e.system.name] = old / 10.0
                 warnings.append(f"{e.warnings[0]}; reran the pass with {e.system.name} "
-                                f"dt={e.system.dt:.3g} s (was {old:.3g} s)")
+                                f"dt={old / 10.0:.3g} s (was {old:.3g} s)")
         for s in p.live:
             monitors[s.name] = monitor
     return tracks, frames, warnings, monitors

@@ -33,7 +33,7 @@ def check_thickness(owner: str, thickness) -> float:
     return t
 
 
-class BVH:
+class AABBTree:
     """A hierarchy over elements (rows of vertex indices: (m,3) triangles or (m,2) segments)
     of a vertex set (n,3) m. Boxes are grown by ``pad`` (m) and span the motion of the step."""
 
@@ -53,6 +53,7 @@ class BVH:
         self.left, self.right, self.prim = K.build(x, e)
         nn = len(self.prim)
         self.lo, self.hi = np.zeros((nn, 3)), np.zeros((nn, 3))
+        self.tree = K.Tree(self.lo, self.hi, self.left, self.right, self.prim)
         self.x = x
         self.refit(x)
         # body-frame boxes, kept so a rigid object's tree is transformed, never rebuilt
@@ -63,8 +64,7 @@ class BVH:
         """Refit every box to vertices x (and x_end, the positions at the end of the step)."""
         self.x = check_points(self.owner, x)
         x1 = self.x if x_end is None else check_points(self.owner, x_end)
-        K.refit(self.lo, self.hi, self.left, self.right, self.prim, self.elements, self.x, x1,
-                self.pad)
+        K.refit(self.tree, self.elements, self.x, x1, self.pad)
 
     def transform(self, R, t, R_end=None, t_end=None):
         """Rigid motion: world boxes from the body-frame boxes at pose (R, t) (and the pose at
@@ -84,23 +84,22 @@ class BVH:
         p = check_points(self.owner, points, "query points")
         n = len(p)
         tri, d, bary = np.empty(n, np.int64), np.empty(n), np.empty((n, 3))
-        K.nearest_triangles(p, float(radius), self.lo, self.hi, self.left, self.right, self.prim,
-                            self.elements, self.x, skip_incident, tri, d, bary)
+        K.nearest_triangles(p, float(radius), self.tree, self.elements, self.x, skip_incident,
+                            tri, d, bary)
         return tri, d, bary
 
-    def overlapping(self, other: "BVH | None" = None) -> np.ndarray:
+    def overlapping(self, other: "AABBTree | None" = None) -> np.ndarray:
         """(k,2) element pairs whose boxes overlap: this tree against another, or against itself
         (each unordered pair once) when other is None."""
         o = self if other is None else other
         out = np.empty((max(64, 4 * len(self.elements)), 2), np.int64)
         while True:
-            n = K.overlap_pairs(self.lo, self.hi, self.left, self.right, self.prim, o.lo, o.hi,
-                                o.left, o.right, o.prim, other is None, out)
+            n = K.overlap_pairs(self.tree, o.tree, other is None, out)
             if n <= len(out):
                 return out[:n].copy()
             out = np.empty((n, 2), np.int64)
 
-    def intersections(self, other: "BVH | None" = None) -> np.ndarray:
+    def intersections(self, other: "AABBTree | None" = None) -> np.ndarray:
         """(k,2) pairs of triangles that interpenetrate (self-intersections when other is None,
         skipping triangles that share a vertex)."""
         o = self if other is None else other
@@ -113,7 +112,7 @@ class BVH:
         intersecting_pairs(self.x, self.elements, o.x, o.elements, pairs, hit)
         return pairs[hit]
 
-    def edge_contacts(self, other: "BVH", reach: float):
+    def edge_contacts(self, other: "AABBTree", reach: float):
         """Segment pairs of two segment trees closer than reach (m): (pairs (k,2), closest-point
         parameters (k,2), distances (k,))."""
         pairs = self.overlapping(other)

@@ -223,3 +223,15 @@ def segment_mesh(shape: tuple, resolution: int = 10):
         tris.append([south, (i + 1) % n, i])
         tris.append([north, (nr - 1) * n + i, (nr - 1) * n + (i + 1) % n])
     return verts, np.array(tris, dtype=np.int64)
+
+
+def segment_primitive(shape: tuple):
+    """The analytic Primitive (geometry/primitive.py) of a segment's shape."""
+    from .primitive import Primitive
+    kind = shape[0]
+    if kind == "box":
+        return Primitive("box", axes=tuple(map(float, shape[1])), centre=tuple(map(float, shape[2])))
+    if kind == "sphere":
+        return Primitive("sphere", radius=float(shape[1]), centre=tuple(map(float, shape[2])))
+    return Primitive("capsule", radius=float(shape[1]), a=tuple(map(float, shape[2])),
+                     b=tuple(map(float, shape[3])))

@@ -1,8 +1,8 @@
 """Aerodynamics of a triangle mesh in a wind field (SPEC 2.2): per-triangle drag and lift.
 
-The primary is the wind (``systems.wind.WindField``), the secondary any point system with
-``triangles`` (a cloth, a flag, a leaf). The air does not feel the cloth: the force on the
-primary is logged (the reaction the air would feel) and never applied.
+The primary is the wind (``systems.wind.WindField``), the secondary any system whose contact
+view is points with triangles (a cloth, a flag, a leaf). The air does not feel the cloth: the
+force on the primary is logged (the reaction the air would feel) and never applied.
 """
 from __future__ import annotations
 
@@ -32,14 +32,14 @@ class Aerodynamics(Interaction):
 
     def __init__(self, name, wind, body, params: AeroParams = AeroParams(), mode="one-way"):
         super().__init__(name, wind, body, mode)
-        tris = getattr(body, "triangles", None)
-        if tris is None:
+        self.body = body.contact_view()
+        if self.body is None or self.body.kind != "points" or self.body.triangles is None:
             raise ParameterError(f"interaction {name}: {body.name} has no triangles; "
                                  "aerodynamics needs a surface mesh (SpringNetwork.from_mesh)")
-        self.tris = np.ascontiguousarray(tris, dtype=np.int64)
+        self.tris = np.ascontiguousarray(self.body.triangles, dtype=np.int64)
         self.cn = require_nonnegative(name, "drag", params.drag, "kg/m^3")
         self.ct = require_nonnegative(name, "friction", params.friction, "kg/(m^2 s)")
-        n = len(body.x)
+        n = len(self.body.x)
         self._idx = np.arange(n)
         self._f = np.zeros((n, 3))
         self._dfdx = np.zeros((n, 3, 3))
@@ -48,7 +48,7 @@ class Aerodynamics(Interaction):
 
     def forces(self, with_jacobian=False):
         """(point forces (n,3) N, their velocity Jacobian (n,3,3) N s/m, total force (3,) N)."""
-        body = self.secondary
+        body = self.body
         K.centroids(body.x, self.tris, self._cent)
         wind = self.primary.velocity(self._cent, body.time)
         self._f[:] = 0.0
@@ -59,12 +59,7 @@ class Aerodynamics(Interaction):
         return self._f, self._dfdv, total
 
     def exchange(self, to_primary, to_secondary):
-        body = self.secondary
-        implicit = getattr(body, "integrator", "explicit") != "explicit"
-        f, dfdv, total = self.forces(implicit)
+        f, dfdv, total = self.forces(self.body.jacobians)
         if to_secondary:
-            if implicit:
-                body.add_point_forces(self._idx, f, self._dfdx, dfdv)
-            else:
-                body.add_point_forces(self._idx, f)
+            self.body.apply(self._idx, f, self._dfdx, dfdv)
         return -total, np.zeros(3), True

@@ -16,9 +16,9 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
+from ..coupling.modes import MODES
 from ..errors import SceneError
-
-MODES = ("two-way", "one-way", "hybrid")
+from ..systems.base import Role
 
 
 class StandIn(ABC):
@@ -32,7 +32,12 @@ class StandIn(ABC):
 
 
 class Interaction(ABC):
-    """Base class: a named force exchange between ``primary`` and ``secondary``."""
+    """Base class: a named force exchange between ``primary`` and ``secondary``.
+
+    two_way_supported: False for interactions whose two-way form is not implemented (the
+    advisor then looks for a stand-in)."""
+
+    two_way_supported = True
 
     def __init__(self, name: str, primary, secondary, mode: str = "two-way",
                  standin: StandIn | None = None):
@@ -58,14 +63,24 @@ class Interaction(ABC):
 
     @property
     def effective_mode(self) -> str:
-        """The mode as it acts: one-way whenever the primary is prescribed (static, a field,
+        """The mode as it acts: one-way whenever the primary is not dynamic (static, a field,
         animation), since nothing can push back on it."""
-        if not (self.primary.dynamic and self.primary.accepts_forces):
+        if self.primary.role is not Role.DYNAMIC:
             return "one-way"
         return self.mode
 
-    def prepare(self, h: float) -> None:
-        """Called at the start of each pass with its coupling step h (s)."""
+    def prepare(self, h: float, dts: dict | None = None) -> None:
+        """Called at the start of each pass with its coupling step h (s) and the largest
+        substep (s) of each system in the pass, by name (an interaction sub-cycled inside its
+        secondary's substeps checks whether there are any); None: each system's own dt."""
+
+    def capture(self) -> dict:
+        """The interaction's own memory (friction anchors, lagged velocities) as plain arrays,
+        for checkpoints; empty for stateless interactions."""
+        return {}
+
+    def restore(self, snap: dict) -> None:
+        """Return to a state from ``capture()``."""
 
     @abstractmethod
     def exchange(self, to_primary: bool, to_secondary: bool):
@@ -79,5 +94,11 @@ class Interaction(ABC):
         raise TypeError(f"{type(self).__name__} never defers its exchange")
 
     def describe(self) -> dict:
-        return {"name": self.name, "primary": self.primary.name,
-                "secondary": self.secondary.name, "mode": self.mode}
+        """What the analysis needs after the run: the names, the mode (and how it acted), the
+        primary's mass and role, the stand-in, whether two-way is implemented."""
+        return {"name": self.name, "type": type(self).__name__, "primary": self.primary.name,
+                "secondary": self.secondary.name, "mode": self.mode,
+                "effective_mode": self.effective_mode, "primary_role": self.primary.role.value,
+                "primary_mass_kg": float(self.primary.mass), "standin": (
+                    None if self.standin is None else self.standin.name),
+                "two_way_supported": self.two_way_supported}

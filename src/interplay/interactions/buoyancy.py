@@ -1,8 +1,9 @@
 """A body in water (SPEC 2.4, objects in water): buoyancy and drag on the body, external
 pressure on the water.
 
-The body (primary: a rigid Sphere, or any body offering ``ellipsoid()`` such as a
-KeyframedBody foot) is cut by the water's columns at every coupling step (``add_ellipsoid``).
+The body (primary: any system whose contact view's first part is a sphere or an ellipsoid
+primitive: a rigid Sphere, a KeyframedBody foot) is cut by the water's columns at every
+coupling step (``add_ellipsoid``).
 Water rising into it meets an external pressure that holds it down (kernels/water.py
 ``heads``), so the water under it is pushed away and rises around it; the volume that
 pressure keeps out, V_sub, is what the body displaces. The water acts back with
@@ -54,14 +55,17 @@ class BuoyancyParams:
         return self
 
 
-def body_ellipsoid(body):
-    """(semi-axes (3,) m, rotation (3, 3)) of a body the water can displace."""
-    if hasattr(body, "ellipsoid"):
-        return body.ellipsoid()
-    if hasattr(body, "radius"):
-        return np.full(3, float(body.radius)), np.eye(3)
-    raise SceneError(f"{body.name} has no shape the water can displace (it needs a radius "
-                     "or an ellipsoid())")
+def body_ellipsoid(view):
+    """(semi-axes (3,) m, rotation (3, 3), whether it turns with the body) of the ellipsoid of
+    a BodiesView's first part: its sphere or ellipsoid primitive (a sphere's rotation does not
+    matter: the identity)."""
+    prim = view.primitives[0] if view is not None and view.kind == "bodies" else None
+    if prim is not None and prim.kind == "sphere":
+        return np.full(3, float(prim.radius)), np.eye(3), False
+    if prim is not None and prim.kind == "ellipsoid":
+        return np.asarray(prim.axes, dtype=float), view.poses()[1][0], True
+    raise SceneError(f"{view.name if view is not None else 'the body'} has no shape the water "
+                     "can displace (its contact view needs a sphere or ellipsoid primitive)")
 
 
 class BodyInWater(Interaction):
@@ -71,7 +75,8 @@ class BodyInWater(Interaction):
                  mode="two-way", standin=None):
         super().__init__(name, body, water, mode, standin)
         self.p = params.validated(name)
-        axes, R = body_ellipsoid(body)
+        self.body = body.contact_view()
+        axes, R, self._turns = body_ellipsoid(self.body)
         self.axes = np.asarray(axes, dtype=float)
         self.volume = 4.0 / 3.0 * math.pi * float(np.prod(self.axes))  # m^3
         self.radius = float(np.prod(self.axes)) ** (1.0 / 3.0)  # m, of the equal-volume sphere
@@ -86,14 +91,14 @@ class BodyInWater(Interaction):
                 f"{across / GOOD_COLUMNS_ACROSS:.3g} m ({GOOD_COLUMNS_ACROSS} across it)",
                 ResolutionWarning, stacklevel=2)
         m_added = self.p.added_mass * water.rho * self.volume
-        if m_added >= body.mass:
+        if m_added >= self.body.masses[0]:
             raise ParameterError(
                 f"{name}: added mass {m_added:.3g} kg (C_a {self.p.added_mass}) is not below "
                 f"{body.name}'s mass {body.mass:.3g} kg; the lagged added-mass force would be "
                 f"unstable: use added_mass < {body.mass / (water.rho * self.volume):.3g} or 0")
         self._out = np.zeros(7)
         self._h = 0.0
-        self._v_prev = np.array(body.v, dtype=float)
+        self._v_prev = self.body.velocities()[0][0].copy()
         self._zero = np.zeros(3)
 
     def _set_rotation(self, R):
@@ -101,35 +106,42 @@ class BodyInWater(Interaction):
         self._M = np.ascontiguousarray(R @ np.diag(a2) @ R.T)
         self._A = np.ascontiguousarray(R @ np.diag(1.0 / a2) @ R.T)
 
-    def prepare(self, h):
+    def prepare(self, h, dts=None):
         self._h = h
-        self._v_prev[:] = self.primary.v
+        self._v_prev[:] = self.body.velocities()[0][0]
+
+    def capture(self):
+        return {"v_prev": self._v_prev.copy()}
+
+    def restore(self, snap):
+        self._v_prev[:] = snap["v_prev"]
 
     def exchange(self, to_primary, to_secondary):
-        body, water, p = self.primary, self.secondary, self.p
-        if hasattr(body, "ellipsoid"):
-            self._set_rotation(body.ellipsoid()[1])
-        lids = water.add_ellipsoid(body.x, float(body.v[2]), self._A, self._M, self.volume,
+        body, water, p = self.body, self.secondary, self.p
+        if self._turns:
+            self._set_rotation(body.poses()[1][0])
+        x = body.centres()[0]
+        lin, ang = body.velocities()
+        v, w = lin[0], ang[0]
+        lids = water.add_ellipsoid(x, float(v[2]), self._A, self._M, self.volume,
                                    keep=to_secondary)
         out = water.body_load(lids, self._out)
         vsub = out[0]
-        acc = (body.v - self._v_prev) / self._h if self._h > 0.0 else self._zero
-        self._v_prev[:] = body.v
+        acc = (v - self._v_prev) / self._h if self._h > 0.0 else self._zero
+        self._v_prev[:] = v
         if vsub <= 0.0:
             return self._zero, self._zero, False
         rho = water.rho
         frac = vsub / self.volume
         buoy = np.array([0.0, 0.0, rho * water.g * vsub])
-        vrel = body.v - out[4:7]
+        vrel = v - out[4:7]
         force = buoy - 0.5 * rho * p.drag * self.area * frac * np.linalg.norm(vrel) * vrel
         if p.added_mass > 0.0:
             force -= p.added_mass * rho * vsub * acc
-        torque = np.cross(out[1:4] - body.x, buoy)
-        w = getattr(body, "w", None)
-        if w is not None:
-            torque -= p.rotational_drag * rho * self.radius ** 5 * frac * np.linalg.norm(w) * w
+        torque = np.cross(out[1:4] - x, buoy)
+        torque -= p.rotational_drag * rho * self.radius ** 5 * frac * np.linalg.norm(w) * w
         if to_primary:
-            body.add_wrench(force, torque)
+            body.apply(0, force, torque)
         return force, torque, True
 
     def submerged(self):

@@ -1,8 +1,10 @@
-"""Penalty contacts with Coulomb friction, specialised for a sphere (SPEC 2.5 response).
+"""Penalty contacts with Coulomb friction, specialised for a sphere (SPEC 2.5 response, the law
+in kernels/contact_law.py).
 
 ``SphereCordContact``: a rigid sphere against the cords of a spring-mass network. Cords are
 segments, so the ball can never slip between two net points; the force acts at the contact
-point on the ball's surface, so friction spins it.
+point on the ball's surface, so friction spins it. When the network takes several substeps per
+coupling step the contact is sub-cycled inside them (the network's sub-cycling hook).
 ``SpherePlaneContact``: a rigid sphere on a static plane (the floor).
 """
 from __future__ import annotations
@@ -11,8 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import require_nonnegative, require_positive
-from ..kernels.contact import sphere_plane, sphere_segments
+from ..errors import SceneError, require_nonnegative, require_positive
+from ..kernels.contact import Sphere, colliders, sphere_elements, sphere_plane
+from ..kernels.springs import point_forces
+from ..systems.base import substeps
 from .base import Interaction
 
 
@@ -36,75 +40,90 @@ class ContactParams:
         require_nonnegative(owner, "contact thickness", self.thickness, "m")
         return self
 
+    def law(self) -> np.ndarray:
+        """The law's row (kernels/contact.py): thickness, c_s, c_d, mu, eps, constraint."""
+        return np.array([self.thickness, self.stiffness, self.damping, self.friction,
+                         self.eps, 1.0 if self.constraint else 0.0])
+
+
+def sphere_of(name, system):
+    """(the system's BodiesView, its sphere's radius m), or SceneError when its first part is
+    not a sphere."""
+    view = system.contact_view()
+    prim = view.primitives[0] if view is not None and view.kind == "bodies" else None
+    if prim is None or prim.kind != "sphere":
+        raise SceneError(f"interaction {name}: {system.name} is not a sphere; this contact "
+                         "needs a body whose contact view is one sphere (use MeshContact for "
+                         "other shapes)")
+    return view, prim.radius
+
+
+def _ball(view, radius) -> Sphere:
+    """The sphere's state now as the contact kernels read it."""
+    v, w = view.velocities()
+    return Sphere(view.centres()[0], v[0], w[0], radius, float(view.masses[0]),
+                  view.free_accelerations()[0])
+
 
 class SphereCordContact(Interaction):
-    """Contact of a rigid sphere (primary) with the springs of a network (secondary)."""
+    """Contact of a rigid sphere (primary) with the springs of a network (secondary); segments
+    (s,2): the cords that collide (default all of its springs)."""
 
     def __init__(self, name, ball, network, params: ContactParams = ContactParams(),
                  mode="two-way", standin=None, segments=None):
         super().__init__(name, ball, network, mode, standin)
         self.p = params.validated(name)
-        self.seg = np.ascontiguousarray(network.segments() if segments is None else segments,
+        self.ball, self.radius = sphere_of(name, ball)
+        self.net = network.contact_view()
+        self.seg = np.ascontiguousarray(self.net.segments if segments is None else segments,
                                         dtype=np.int64)
-        ns = len(self.seg)
-        self._idx = np.zeros(2 * ns, dtype=np.int64)
-        self._f = np.zeros((2 * ns, 3))
-        self._dfdx = np.zeros((2 * ns, 3, 3))
-        self._dfdv = np.zeros((2 * ns, 3, 3))
-        self._vref = np.zeros((2 * ns, 3))
+        self._out = point_forces(2 * len(self.seg))
         self._wrench = np.zeros(6)
+        self._law = self.p.law()
+        self._cols = colliders(1)
         self._k = 0
-        self._h, self._subcycle, self._slot = 0.0, False, 0
-        self._contact6 = (self.p.thickness, self.p.stiffness, self.p.damping, self.p.friction,
-                          self.p.eps, 1.0 if self.p.constraint else 0.0)
-        self._zero_acc = np.zeros((network.x.shape[0], 3))
+        self._h, self._subcycle = 0.0, False
+        self._zero_acc = np.zeros((len(self.net.x), 3))
 
-    def prepare(self, h):
-        """Called once per pass with the coupling step h (s): when the network takes several
-        substeps per coupling step, the contact is sub-cycled inside the network's kernel
-        against the ball's predicted path, and the ball receives the step's mean force."""
+    def prepare(self, h, dts=None):
+        """When the network takes several substeps per coupling step, the contact is
+        sub-cycled inside its kernel against the ball's predicted path, and the ball receives
+        the step's mean force."""
         self._h = h
-        self._subcycle = self.secondary.dt < h * (1.0 - 1e-9)
+        dt = (dts or {}).get(self.secondary.name, self.secondary.dt)
+        self._subcycle = substeps(h, dt) > 1
 
     def exchange(self, to_primary, to_secondary):
-        ball, net, p = self.primary, self.secondary, self.p
+        ball = _ball(self.ball, self.radius)
         if self._subcycle and to_secondary:
-            acc = ball.gravity + ball.force / ball.mass
-            self._slot = net.add_moving_sphere(self.seg, ball.x.copy(), ball.v.copy(),
-                                               ball.w.copy(), acc, ball.radius, ball.mass,
-                                               self._contact6)
-            return None
-        if p.constraint:
-            pt_acc = net.internal_forces() / net.m[:, None]
-        else:
-            pt_acc = self._zero_acc
-        self._k = k = sphere_segments(ball.x, ball.v, ball.w, ball.radius, ball.mass, ball.gravity,
-                            net.x, net.v, net.m, pt_acc, self.seg, p.thickness, p.stiffness,
-                            p.damping, p.friction, p.eps, p.constraint,
-                            self._h, self._idx, self._f,
-                            self._dfdx, self._dfdv, self._vref, self._wrench)
+            c = self._cols
+            c.centres[0], c.velocities[0], c.spins[0], c.accels[0] = ball.c, ball.v, ball.w, ball.acc
+            c.radii[0], c.masses[0], c.law[0] = ball.radius, ball.mass, self._law
+            if self.net.subcycle(c, self.seg):
+                return None
+        pt_acc = self.net.accelerations() if self.p.constraint else self._zero_acc
+        self._k = k = sphere_elements(ball, self.net.points, pt_acc, self.seg, self._law,
+                                      self._h, self._out, True, self._wrench)
         if k == 0:
             return self._wrench[:3], self._wrench[3:], False
         if to_primary:
-            ball.force += self._wrench[:3]
-            ball.torque += self._wrench[3:]
+            self.ball.apply(0, self._wrench[:3], self._wrench[3:])
         if to_secondary:
-            net.add_point_forces(self._idx[:k], self._f[:k], self._dfdx[:k], self._dfdv[:k],
-                                 self._vref[:k])
+            o = self._out
+            self.net.apply(o.idx[:k], o.f[:k], o.dfdx[:k], o.dfdv[:k], o.vref[:k])
         return self._wrench[:3].copy(), self._wrench[3:].copy(), True
 
     def complete(self, to_primary):
         """After the network's sub-cycled advance: the mean force and torque of the step."""
-        imp = self.secondary.impulses[self._slot]
+        imp = self._cols.impulses[0]
         f, tau = imp[:3] / self._h, imp[3:6] / self._h
         if to_primary:
-            self.primary.force += f
-            self.primary.torque += tau
+            self.ball.apply(0, f, tau)
         return f, tau, bool(imp[6] > 0.0), imp[6]
 
     def point_forces(self):
-        """The last exchange's (indices, forces) on the network's points (for checks)."""
-        return self._idx[:self._k], self._f[:self._k]
+        """The last lock-step exchange's (indices, forces) on the network's points."""
+        return self._out.idx[:self._k], self._out.f[:self._k]
 
 
 class SpherePlaneContact(Interaction):
@@ -113,6 +132,11 @@ class SpherePlaneContact(Interaction):
     def __init__(self, name, ball, plane, params: ContactParams, mode="two-way"):
         super().__init__(name, ball, plane, mode)
         self.p = params.validated(name)
+        self.ball, self.radius = sphere_of(name, ball)
+        self.height = plane.contact_view().height
+        if self.height is None:
+            raise SceneError(f"interaction {name}: {plane.name} is not a plane")
+        self._law = self.p.law()
         self._wrench = np.zeros(6)
         self._dfdx = np.zeros((3, 3))
         self._dfdx[2, 2] = -self.p.stiffness
@@ -120,16 +144,15 @@ class SpherePlaneContact(Interaction):
         self._dfdv[2, 2] = -self.p.damping
         self._h = 0.0
 
-    def prepare(self, h):
+    def prepare(self, h, dts=None):
         self._h = h  # the friction cap: the force is held over the whole coupling step
 
     def exchange(self, to_primary, to_secondary):
-        ball, p = self.primary, self.p
-        on = sphere_plane(ball.x, ball.v, ball.w, ball.radius, ball.mass, ball.inertia_body[0],
-                          ball.gravity[2], self.secondary.height, p.stiffness, p.damping,
-                          p.friction, p.eps, self._h, self._wrench)
+        inertia = 1.0 / self.ball.inverse_inertias()[0, 0, 0]  # a sphere's is isotropic
+        on = sphere_plane(_ball(self.ball, self.radius), inertia, self.height, self._law,
+                          self._h, self._wrench)
         if on and to_primary:
             # the normal penalty's Jacobians let the ball integrate the bounce implicitly
-            ball.add_wrench(self._wrench[:3], self._wrench[3:], dfdx=self._dfdx,
+            self.ball.apply(0, self._wrench[:3], self._wrench[3:], dfdx=self._dfdx,
                             dfdv=self._dfdv)
         return self._wrench[:3].copy(), self._wrench[3:].copy(), on

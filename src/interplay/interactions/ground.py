@@ -1,4 +1,5 @@
-"""Points on the ground: a penalty plane with Coulomb friction for cloth and leaves.
+"""Points on the ground: a penalty plane with Coulomb friction for cloth and leaves (the one
+contact law, per kilogram of point mass: ``kernels.contact.points_on_plane``).
 
 Every point below the plane (plus a thickness) is pushed up by a spring-damper scaled by its
 own mass (so a 10 mg leaf point and a 10 g cloth point sink equally: sag = g / stiffness) and
@@ -11,7 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import require_nonnegative, require_positive
+from ..errors import SceneError, require_nonnegative, require_positive
+from ..kernels.contact import points_on_plane
+from ..kernels.springs import point_forces
 from .base import Interaction
 
 
@@ -29,39 +32,29 @@ class GroundParams:
 
 
 class GroundContact(Interaction):
-    """A ``StaticPlane`` (primary) under the points of ``body`` (secondary)."""
+    """A plane (primary: a static system whose contact view has a height) under the points of
+    ``body`` (secondary: a system seen as points)."""
 
     def __init__(self, name, plane, body, params: GroundParams = GroundParams(), mode="one-way"):
         super().__init__(name, plane, body, mode)
-        self.k = require_positive(name, "stiffness", params.stiffness, "1/s^2")
-        self.c = require_nonnegative(name, "damping", params.damping, "1/s")
-        self.mu = require_nonnegative(name, "friction", params.friction)
-        self.eps = require_positive(name, "eps", params.eps, "m/s")
-        self.level = plane.height + require_nonnegative(name, "thickness", params.thickness, "m")
+        k = require_positive(name, "stiffness", params.stiffness, "1/s^2")
+        c = require_nonnegative(name, "damping", params.damping, "1/s")
+        mu = require_nonnegative(name, "friction", params.friction)
+        eps = require_positive(name, "eps", params.eps, "m/s")
+        height = plane.contact_view().height
+        self.body = body.contact_view()
+        if height is None or self.body is None or self.body.kind != "points":
+            raise SceneError(f"interaction {name}: needs a plane ({plane.name}) under a system "
+                             f"of points ({body.name})")
+        self.level = height + require_nonnegative(name, "thickness", params.thickness, "m")
+        self._law = np.array([0.0, k, c, mu, eps, 0.0])
+        self._out = point_forces(len(self.body.x))
 
     def exchange(self, to_primary, to_secondary):
-        body = self.secondary
-        x, v, m = body.x, body.v, body.m
-        idx = np.flatnonzero(x[:, 2] < self.level)
-        if len(idx) == 0:
+        o = self._out
+        k = points_on_plane(self.body.points, self.level, self._law, o, self.body.jacobians)
+        if k == 0:
             return np.zeros(3), np.zeros(3), False
-        mi, vi = m[idx], v[idx]
-        fn = np.maximum(mi * (self.k * (self.level - x[idx, 2]) - self.c * vi[:, 2]), 0.0)
-        slide = np.maximum(np.hypot(vi[:, 0], vi[:, 1]), self.eps)
-        mu_v = self.mu * fn / slide  # N s/m: friction as a damper that saturates at mu f_n
-        f = np.zeros((len(idx), 3))
-        f[:, 0] = -mu_v * vi[:, 0]
-        f[:, 1] = -mu_v * vi[:, 1]
-        f[:, 2] = fn
         if to_secondary:
-            if getattr(body, "integrator", "explicit") != "explicit":
-                pressing = fn > 0.0
-                dfdx = np.zeros((len(idx), 3, 3))
-                dfdv = np.zeros((len(idx), 3, 3))
-                dfdx[:, 2, 2] = np.where(pressing, -mi * self.k, 0.0)
-                dfdv[:, 2, 2] = np.where(pressing, -mi * self.c, 0.0)
-                dfdv[:, 0, 0] = dfdv[:, 1, 1] = -mu_v
-                body.add_point_forces(idx, f, dfdx, dfdv)
-            else:
-                body.add_point_forces(idx, f)
-        return -f.sum(axis=0), np.zeros(3), True
+            self.body.apply(o.idx[:k], o.f[:k], o.dfdx[:k], o.dfdv[:k], o.vref[:k])
+        return -o.f[:k].sum(axis=0), np.zeros(3), True

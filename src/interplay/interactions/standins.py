@@ -8,6 +8,7 @@ import numpy as np
 from ..errors import require_nonnegative, require_positive
 from ..kernels.contact import sphere_segment_overlap
 from .base import StandIn
+from .contact import sphere_of
 
 
 @dataclass(frozen=True)
@@ -42,14 +43,15 @@ class DampingField(StandIn):
     def act(self, ball):
         if not self.p.enabled:
             return self._zero, self._zero, False
-        overlap = sphere_segment_overlap(ball.x, ball.radius, self.rest, self.seg,
-                                         ball.radius + self.thickness)
+        view, radius = sphere_of(self.name, ball)
+        c = view.centres()[0]
+        overlap = sphere_segment_overlap(c, radius, self.rest, self.seg, radius + self.thickness)
         if overlap <= 0.0:
             return self._zero, self._zero, False
-        f = -self.p.linear * overlap * ball.v
-        tau = -self.p.angular * overlap * ball.w
-        ball.force += f
-        ball.torque += tau
+        lin, ang = view.velocities()
+        f = -self.p.linear * overlap * lin[0]
+        tau = -self.p.angular * overlap * ang[0]
+        view.apply(0, f, tau)
         return f, tau, True
 
 
@@ -87,13 +89,14 @@ class ViscousDragField(StandIn):
 
     def act(self, body):
         p = self.p
-        t = min(max((p.surface - body.x[2] + self.half_height) / (2.0 * self.half_height),
-                    0.0), 1.0)
+        view = body.contact_view()
+        t = min(max((p.surface - view.centres()[0][2] + self.half_height)
+                    / (2.0 * self.half_height), 0.0), 1.0)
         if not p.enabled or t <= 0.0:
             return self._zero, self._zero, False
         f = t * t * (3.0 - 2.0 * t)
-        v = body.v
+        v = view.velocities()[0][0]
         force = -(p.linear + p.quadratic * float(np.linalg.norm(v))) * f * v
         force[2] += p.density * p.gravity * self.volume * f
-        body.add_wrench(force)
+        view.apply(0, force)
         return force, self._zero, True

@@ -7,10 +7,22 @@ nodes). Every leaf holds one element; children are numbered after their parent, 
 walks the nodes backwards. Elements are rows of vertex indices: (m,3) triangles, (m,2)
 segments, (m,1) points. Traversals use an explicit stack (no recursion in Numba).
 """
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, prange
 
 from .trimesh_contact import closest_on_triangle
+
+
+class Tree(NamedTuple):
+    """A hierarchy's nodes: lo, hi (nodes, 3) boxes (m), left, right (nodes,) children, prim
+    (nodes,) the element of a leaf (-1 for interior nodes)."""
+    lo: np.ndarray
+    hi: np.ndarray
+    left: np.ndarray
+    right: np.ndarray
+    prim: np.ndarray
 
 STACK = 96  # deeper than any median-split tree of < 2^40 elements (depth ~ log2 m + 1)
 
@@ -68,11 +80,12 @@ def build(x, elems):
 
 
 @njit(cache=True, parallel=True)
-def refit(lo, hi, left, right, prim, elems, x0, x1, pad):
+def refit(tree, elems, x0, x1, pad):
     """Boxes of every node: each leaf bounds its element at both x0 and x1 (the start and end of
     the step, so a contact during the step is not missed), grown by pad (m); interior nodes
     bound their children. Leaves in parallel (each writes its own box), then the interior
     nodes backwards (children are numbered after their parents)."""
+    lo, hi, left, right, prim = tree
     k = elems.shape[1]
     for node in prange(lo.shape[0]):
         e = prim[node]
@@ -131,9 +144,10 @@ def _box_dist2(p, lo, hi, node):
 
 
 @njit(cache=True, inline="always")
-def _nearest_one(p, i, radius, lo, hi, left, right, prim, tris, x, skip_incident, st):
+def _nearest_one(p, i, radius, tree, tris, x, skip_incident, st):
     """Nearest triangle to point p (index i) within radius: (triangle or -1, squared distance,
     barycentric weights). st: a scratch stack."""
+    lo, hi, left, right, prim = tree
     best = radius * radius
     bt = -1
     b0, b1, b2 = 0.0, 0.0, 0.0
@@ -160,8 +174,7 @@ def _nearest_one(p, i, radius, lo, hi, left, right, prim, tris, x, skip_incident
 
 
 @njit(cache=True, parallel=True)
-def nearest_triangles(pts, radius, lo, hi, left, right, prim, tris, x, skip_incident,
-                      out_tri, out_d, out_bary):
+def nearest_triangles(pts, radius, tree, tris, x, skip_incident, out_tri, out_d, out_bary):
     """For each point, the nearest triangle within radius (m) of it: index (-1 if none),
     distance (m) and barycentric weights of the closest point. skip_incident: ignore triangles
     having the point (same index) as a vertex (a network against itself). Race-free: each
@@ -171,8 +184,8 @@ def nearest_triangles(pts, radius, lo, hi, left, right, prim, tris, x, skip_inci
     for c in prange((n + chunk - 1) // chunk):
         st = np.empty(STACK, np.int64)
         for i in range(c * chunk, min(n, (c + 1) * chunk)):
-            bt, d2, b0, b1, b2 = _nearest_one(pts[i], i, radius, lo, hi, left, right, prim,
-                                              tris, x, skip_incident, st)
+            bt, d2, b0, b1, b2 = _nearest_one(pts[i], i, radius, tree, tris, x,
+                                              skip_incident, st)
             out_tri[i] = bt
             out_d[i] = np.sqrt(d2) if bt >= 0 else np.inf
             out_bary[i, 0], out_bary[i, 1], out_bary[i, 2] = b0, b1, b2
@@ -187,12 +200,13 @@ def _overlap(loa, hia, a, lob, hib, b):
 
 
 @njit(cache=True)
-def overlap_pairs(loa, hia, lefta, righta, prima, lob, hib, leftb, rightb, primb, self_tree,
-                  out):
+def overlap_pairs(ta, tb, self_tree, out):
     """Element pairs (ea, eb) of two trees whose leaf boxes overlap, by descending both trees
     from the roots. self_tree: the same tree twice; each unordered pair once, no element with
     itself. Writes up to len(out) pairs; returns the total count (call again with a larger out
     when it exceeds it)."""
+    loa, hia, lefta, righta, prima = ta
+    lob, hib, leftb, rightb, primb = tb
     cap = out.shape[0]
     n = 0
     st = np.empty((4 * STACK, 2), np.int64)

@@ -1,13 +1,54 @@
-"""Contact kernels: a sphere against cord segments and against a plane (SPEC 2.5 response).
+"""Contact kernels for spheres and points: a sphere against cord segments or points, a sphere
+on a plane, points on a plane (SPEC 2.5). Each finds its contacts and applies the one contact
+law (``contact_law``: stabilised penalty with the constraint term, regularised Coulomb
+friction).
 
-Normal force f_n = f_c + c_s p + c_d pdot (clamped at zero: contacts push, never pull), where p
-is the penetration depth (m), pdot its rate (m/s), and f_c the constraint term: the force that
-cancels the relative acceleration (from all other forces) pushing the two bodies together,
-f_c = -m_eff min(0, a_rel.n) with m_eff the pair's reduced mass at the contact point.
-Friction is regularized Coulomb: f_t = -mu f_n min(1, |v_t|/eps) v_t/|v_t|.
+A contact law's coefficients travel as a row ``law`` (6,): THICKNESS (m, the contact skin, e.g.
+a cord's radius), STIFFNESS c_s (N/m), DAMPING c_d (N s/m), FRICTION mu (-), EPS (m/s, the slip
+speed of full Coulomb friction), CONSTRAINT (1: include the constraint term).
 """
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+from .contact_law import friction_damping, normal_force, sliding_friction
+
+THICKNESS, STIFFNESS, DAMPING, FRICTION, EPS, CONSTRAINT = range(6)
+
+
+class Sphere(NamedTuple):
+    """A moving sphere: centre c (3,) m, velocity v (3,) m/s, angular velocity w (3,) rad/s,
+    radius (m), mass (kg), and its free acceleration acc (3,) m/s^2 from every other force
+    (what the constraint term cancels)."""
+    c: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
+    radius: float
+    mass: float
+    acc: np.ndarray
+
+
+class Colliders(NamedTuple):
+    """Rigid spheres that move along predicted paths c0 + v t + a t^2 / 2 through the substeps
+    of a secondary that evaluates them itself (the sub-cycling hook): centres, velocities,
+    spins, accels (k,3); radii, masses (k,); law (k,6) each one's contact law; impulses (k,7)
+    receives, per advance, the impulse (N s) and angular impulse about the centre (N m s)
+    the secondary exerted on each, and the peak force (N) of any substep."""
+    centres: np.ndarray
+    velocities: np.ndarray
+    spins: np.ndarray
+    accels: np.ndarray
+    radii: np.ndarray
+    masses: np.ndarray
+    law: np.ndarray
+    impulses: np.ndarray
+
+
+def colliders(k: int) -> Colliders:
+    """Zeroed Colliders for k spheres (an interaction fills them at every exchange)."""
+    return Colliders(np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
+                     np.zeros(k), np.zeros(k), np.zeros((k, 6)), np.zeros((k, 7)))
 
 
 @njit(cache=True, inline="always")
@@ -44,23 +85,25 @@ def _far(c, reach, x, ia, ib):
 
 
 @njit(cache=True)
-def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg, thickness,
-                    cs, cd, mu, eps, constraint, dt, out_idx, out_f, out_dfdx, out_dfdv, out_vref,
-                    ball_wrench):
-    """Contacts of a sphere (centre c, velocity vc, angular velocity w) with segments of points.
+def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrench):
+    """Contacts of a Sphere ``ball`` with elements of a network's Points: segments (s,2) of
+    point indices, or points given as (p, p) pairs.
 
-    Writes forces on the segment end points (equal and opposite to the ball's, split by the
-    closest-point weights) with their 3x3 Jacobians for implicit integrators and the velocity of
-    the ball's surface at the contact (what the penetration is relative to) into out_*,
-    and the total force (0:3) and torque about the centre (3:6) on the ball into ball_wrench.
-    dt (s) is the step the forces will be held for: friction is capped at the force that stops
-    the tangential slip within that step (m_eff |v_t| / dt), because the regularized law's
-    viscous range (mu f_n / eps per m/s on a net knot of a fraction of a gram) would otherwise
-    make explicit steps chatter. dt <= 0 disables the cap.
-    Returns the number of point entries written (2 per touching segment).
+    Writes, into the PointForces ``out``, the forces on the elements' points (equal and
+    opposite to the ball's, split by the closest-point weights; one entry per point of a
+    touching element), with their 3x3 Jacobians when ``with_jacobian`` and the velocity of the
+    ball's surface at the contact (what the penetration is relative to); and the total force
+    (0:3) and torque about the centre (3:6) on the ball into ``wrench``. pt_acc (n,3): the
+    points' accelerations from their other forces (for the constraint term). dt (s) is the
+    step the forces are held for (friction's cap; <= 0: none). Returns the entries written.
     """
+    c, vc, w, radius, ball_mass, ball_acc = ball
+    x, v, m, _ = pts
+    out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
+    thickness, cs, cd, mu, eps = law[THICKNESS], law[STIFFNESS], law[DAMPING], law[FRICTION], law[EPS]
+    constraint = law[CONSTRAINT] > 0.5
     for q in range(6):
-        ball_wrench[q] = 0.0
+        wrench[q] = 0.0
     reach = radius + thickness
     k = 0
     # scratch vectors, allocated once per call rather than per contact
@@ -71,9 +114,9 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
     vt = np.empty(3)
     F = np.empty(3)
     tau = np.empty(3)
-    for s in range(seg.shape[0]):
-        ia = seg[s, 0]
-        ib = seg[s, 1]
+    for s in range(elems.shape[0]):
+        ia = elems[s, 0]
+        ib = elems[s, 1]
         if _far(c, reach, x, ia, ib):
             continue
         t, dx, dy, dz, d2 = _offset_from_segment(c, x, ia, ib)
@@ -94,14 +137,12 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         for q in range(3):
             vrel[q] = vball[q] - (wa * v[ia, q] + wb * v[ib, q])
             vn += vrel[q] * n[q]
-        fn = cs * pen - cd * vn
         inv_m = 1.0 / ball_mass + wa * wa / m[ia] + wb * wb / m[ib]
+        an = 0.0
         if constraint:
-            an = 0.0
             for q in range(3):
                 an += (ball_acc[q] - (wa * pt_acc[ia, q] + wb * pt_acc[ib, q])) * n[q]
-            if an < 0.0:
-                fn += -an / inv_m
+        fn = normal_force(pen, vn, an, inv_m, cs, cd, constraint)
         if fn <= 0.0:
             continue
         vtn = 0.0
@@ -111,47 +152,44 @@ def sphere_segments(c, vc, w, radius, ball_mass, ball_acc, x, v, m, pt_acc, seg,
         vtn = np.sqrt(vtn)
         ft_scale = 0.0  # friction force = ft_scale * vt
         if vtn > 0.0:
-            fmag = mu * fn * min(1.0, vtn / eps)
-            if dt > 0.0:
-                fmag = min(fmag, vtn / (inv_m * dt))
-            ft_scale = -fmag / vtn
+            ft_scale = -sliding_friction(fn, vtn, mu, eps, inv_m, dt) / vtn
         for q in range(3):
             F[q] = fn * n[q] + ft_scale * vt[q]
         tau[0] = r[1] * F[2] - r[2] * F[1]
         tau[1] = r[2] * F[0] - r[0] * F[2]
         tau[2] = r[0] * F[1] - r[1] * F[0]
         for q in range(3):
-            ball_wrench[q] += F[q]
-            ball_wrench[3 + q] += tau[q]
+            wrench[q] += F[q]
+            wrench[3 + q] += tau[q]
         # Jacobians of the point forces: penalty along n; damping along n; friction in the
-        # tangent plane while it is in its viscous (regularized) range.
-        visc = mu * fn / eps if vtn < eps else 0.0
-        if dt > 0.0:
-            visc = min(visc, 1.0 / (inv_m * dt))
-        for side in range(2):
+        # tangent plane (the law's secant damping)
+        visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
+        for side in range(1 if ia == ib else 2):
             p = ia if side == 0 else ib
             wgt = wa if side == 0 else wb
             out_idx[k] = p
             for a in range(3):
-                out_vref[k, a] = vball[a]
-            for a in range(3):
                 out_f[k, a] = -wgt * F[a]
-                for b in range(3):
-                    nn = n[a] * n[b]
-                    out_dfdx[k, a, b] = -wgt * wgt * cs * nn
-                    tan = (1.0 if a == b else 0.0) - nn
-                    out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
+            if with_jacobian:
+                for a in range(3):
+                    out_vref[k, a] = vball[a]
+                    for b in range(3):
+                        nn = n[a] * n[b]
+                        out_dfdx[k, a, b] = -wgt * wgt * cs * nn
+                        tan = (1.0 if a == b else 0.0) - nn
+                        out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
             k += 1
     return k
 
 
 @njit(cache=True)
-def sphere_plane(c, vc, w, radius, mass, inertia, acc_n, height, cs, cd, mu, eps, dt, wrench):
-    """A sphere on the plane z = height (normal +z). acc_n: the sphere's free acceleration
-    along +z (m/s^2); inertia: its moment of inertia (kg m^2). Writes force (0:3) and torque
-    (3:6) on the sphere; returns True on contact. Friction is capped at the force that stops
-    the contact point's slip within dt (through both the sphere's mass and its inertia), so a
+def sphere_plane(ball, inertia, height, law, dt, wrench):
+    """A Sphere on the plane z = height (m, normal +z), its acc the free acceleration whose z
+    part the constraint term cancels; inertia (kg m^2) its moment of inertia. Writes force
+    (0:3) and torque (3:6) on the sphere; returns True on contact. Friction's cap acts through
+    both the sphere's mass and its inertia (the contact point's effective mass for slip), so a
     rolling ball does not chatter; dt <= 0 disables the cap."""
+    c, vc, w, radius, mass, acc = ball
     for q in range(6):
         wrench[q] = 0.0
     pen = radius - (c[2] - height)
@@ -161,18 +199,16 @@ def sphere_plane(c, vc, w, radius, mass, inertia, acc_n, height, cs, cd, mu, eps
     vx = vc[0] - w[1] * radius
     vy = vc[1] + w[0] * radius
     vz = vc[2]
-    fn = cs * pen - cd * vz
-    if acc_n < 0.0:
-        fn += -mass * acc_n
+    fn = normal_force(pen, vz, acc[2], 1.0 / mass, law[STIFFNESS], law[DAMPING],
+                      law[CONSTRAINT] > 0.5)
     if fn <= 0.0:
         return False
     fx = 0.0
     fy = 0.0
     vtn = np.sqrt(vx * vx + vy * vy)
     if vtn > 0.0:
-        fmag = mu * fn * min(1.0, vtn / eps)
-        if dt > 0.0:
-            fmag = min(fmag, vtn / ((1.0 / mass + radius * radius / inertia) * dt))
+        fmag = sliding_friction(fn, vtn, law[FRICTION], law[EPS],
+                                1.0 / mass + radius * radius / inertia, dt)
         fx = -fmag * vx / vtn
         fy = -fmag * vy / vtn
     wrench[0] = fx
@@ -194,3 +230,44 @@ def sphere_segment_overlap(c, radius, x, seg, reach):
         if d2 < reach * reach:
             total += (reach - np.sqrt(d2)) / radius
     return total
+
+
+@njit(cache=True)
+def points_on_plane(pts, level, law, out, with_jacobian):
+    """Points (a network's Points) below the plane z = level (m) pushed up and held by
+    friction, the law per kilogram of point mass (law's STIFFNESS in N/m per kg = 1/s^2,
+    DAMPING in 1/s: every point sinks the same g / stiffness whatever its mass; no constraint
+    term, no friction cap). Friction is the law's regularised Coulomb written as a saturating
+    damper, -friction_damping(...) v_t. Writes the forces (and their Jacobians when
+    ``with_jacobian``) of every point below the plane into the PointForces ``out``; returns
+    their count (a point whose normal force clamps to zero gets a zero entry)."""
+    x, v, m, _ = pts
+    out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
+    k_kg, c_kg, mu, eps = law[STIFFNESS], law[DAMPING], law[FRICTION], law[EPS]
+    k = 0
+    for p in range(x.shape[0]):
+        if not x[p, 2] < level:
+            continue
+        fn = m[p] * normal_force(level - x[p, 2], v[p, 2], 0.0, 1.0, k_kg, c_kg, False)
+        pressing = fn > 0.0
+        if not pressing:
+            fn = 0.0
+        vtn = np.hypot(v[p, 0], v[p, 1])
+        visc = friction_damping(fn, vtn, mu, eps, 1.0, 0.0)
+        out_idx[k] = p
+        out_f[k, 0] = -visc * v[p, 0]
+        out_f[k, 1] = -visc * v[p, 1]
+        out_f[k, 2] = fn
+        if with_jacobian:
+            for a in range(3):
+                out_vref[k, a] = 0.0
+                for b in range(3):
+                    out_dfdx[k, a, b] = 0.0
+                    out_dfdv[k, a, b] = 0.0
+            if pressing:
+                out_dfdx[k, 2, 2] = -m[p] * k_kg
+                out_dfdv[k, 2, 2] = -m[p] * c_kg
+            out_dfdv[k, 0, 0] = -visc
+            out_dfdv[k, 1, 1] = -visc
+        k += 1
+    return k

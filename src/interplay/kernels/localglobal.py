@@ -23,24 +23,83 @@ line search (the objective never rises). With memory 0 it is plain local/global.
 
 Fixed points are not unknowns. External forces (aero, contacts, attachments) enter y
 explicitly; their Jacobians are ignored, so very stiff penalty couplings need a small step here
-(or the explicit/implicit integrators). Moving spheres are handled as a position projection (an
-infinitely stiff contact) after each step with Coulomb friction on the velocity; the momentum
-removed from the network is returned as the sphere's impulse.
+(or the explicit/implicit integrators). Sub-cycled colliders (moving spheres, ``subcycle``) act
+on the points after each step through the contact law integrated by backward Euler for each
+point alone (``contact_law.backward_euler_normal``: a stiff law is then the projection onto
+the surface, with the position and velocity of the point consistent), with the law's friction;
+the momentum the network loses is returned as the collider's impulse.
 """
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .multigrid import vcycle
+from .contact import DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS, Sphere
+from .contact_law import backward_euler_normal, sliding_friction
+from .multigrid import Hierarchy, Workspace, vcycle
+from .springs import Points, SpringSet
 
 
-def system_matrix(m, fixed, si, sj, k, a_idx, a_k, a_c, alpha, beta, h):
-    """The global matrix for step h over the free points, and each point's index among them.
+class Direct(NamedTuple):
+    """The factor A[perm][:, perm] = L D L^T: the strict lower part of L in CSC (Lp, Li, Lx),
+    dinv = 1 / D and perm (the position of each unknown in the permuted system)."""
+    Lp: np.ndarray
+    Li: np.ndarray
+    Lx: np.ndarray
+    dinv: np.ndarray
+    perm: np.ndarray
 
-    m (n,) kg, fixed (n,) bool, springs (si, sj) with k (N/m), anchors a_idx with a_k (N/m)
-    and a_c (N s/m), alpha (1/s), beta (s). Returns (fid (n,), -1 for fixed points; A, scipy
-    CSC, kg)."""
+
+class Factors(NamedTuple):
+    """What applies A^-1: fid (n,) each point's unknown (-1 for fixed points), and either the
+    Direct factor or a multigrid Hierarchy with its Workspace (the unused one empty)."""
+    fid: np.ndarray
+    direct: Direct
+    mg: Hierarchy
+    work: Workspace
+
+
+class History(NamedTuple):
+    """L-BFGS memory: S, Y (mem + 1, nf, 3) a ring of position and gradient changes, rho their
+    1 / s.y, count (1,) the pairs stored so far. It survives from step to step."""
+    S: np.ndarray
+    Y: np.ndarray
+    rho: np.ndarray
+    count: np.ndarray
+
+
+class Objective(NamedTuple):
+    """Backward Euler's objective for one step: fid, the springs, u (ns,3) and cn (ns,) each
+    spring's unit direction and u . d at the step's start, diag (nf,) and base (nf,3) its
+    quadratic and linear parts, hh = h^2 and hb = h beta (s^2)."""
+    fid: np.ndarray
+    springs: SpringSet
+    u: np.ndarray
+    cn: np.ndarray
+    diag: np.ndarray
+    base: np.ndarray
+    hh: float
+    hb: float
+
+
+class Settings(NamedTuple):
+    """beta (s): stiffness-proportional damping; iters: most L-BFGS iterations a step; tol:
+    stop when an iteration moves no point by more than tol times the first one did."""
+    beta: float
+    iters: int
+    tol: float
+
+
+def system_matrix(net, beta, h):
+    """The global matrix for step h (s) over the free points of a springs.Network, and each
+    point's index among them. beta (s): the stiffness-proportional damping. Returns (fid (n,),
+    -1 for fixed points; A, scipy CSC, kg)."""
+    m, fixed = net.pts.m, net.pts.fixed
+    si, sj, k = net.springs.i, net.springs.j, net.springs.k
+    a_idx, a_k, a_c = net.anchors.idx, net.anchors.k, net.anchors.c
+    alpha = net.alpha
     n = len(m)
     free = ~fixed
     fid = np.full(n, -1, dtype=np.int64)
@@ -73,34 +132,35 @@ def factor(A):
     perm = np.empty_like(lu.perm_c)
     perm[lu.perm_c] = np.arange(len(perm))
     # 32-bit row indices: the triangular solves are memory-bound (12 instead of 16 bytes a nonzero)
-    return (L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
-            1.0 / lu.U.diagonal(), perm.astype(np.int64))
+    return Direct(L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
+                  1.0 / lu.U.diagonal(), perm.astype(np.int64))
 
 
 # what a preconditioner slot holds when the other one is in use (same types: one compilation)
-NO_DIRECT = (np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0), np.zeros(0),
-             np.zeros(0, np.int64))
-NO_MULTIGRID = (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(1, np.int64),
-                np.zeros(0, np.int32), np.zeros(0), np.zeros(1, np.int64),
-                np.zeros(0, np.int32), np.zeros(0), np.zeros(0), np.zeros((0, 0)),
-                np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)))
+NO_DIRECT = Direct(np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0), np.zeros(0),
+                   np.zeros(0, np.int64))
+NO_MULTIGRID = Hierarchy(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(1, np.int64),
+                         np.zeros(0, np.int32), np.zeros(0), np.zeros(1, np.int64),
+                         np.zeros(0, np.int32), np.zeros(0), np.zeros(0), np.zeros((0, 0)))
+NO_WORKSPACE = Workspace(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)))
 
 
 @njit(cache=True)
-def _apply_h0(direct, mg, q, z):
-    """q <- A^-1 q (approximately): one multigrid V-cycle when mg has levels, else the
-    factored solve; z is scratch."""
-    if mg[0].shape[0] > 0:
-        vcycle(*mg, q, z)
+def _apply_h0(pre, q, z):
+    """q <- A^-1 q (approximately) with the Factors ``pre``: one multigrid V-cycle when it has
+    levels, else the factored solve; z is scratch."""
+    if pre.mg.sizes.shape[0] > 0:
+        vcycle(pre.mg, pre.work, q, z)
         q[:] = z
     else:
-        ldl_solve(*direct, q, z, q)
+        ldl_solve(pre.direct, q, z, q)
 
 
 @njit(cache=True)
-def ldl_solve(Lp, Li, Lx, dinv, perm, b, z, out):
-    """Solve A out = b for three right-hand sides (columns), A[perm][:, perm] = L D L^T with L
-    unit lower triangular (strict part in CSC) and dinv = 1 / D; z is scratch."""
+def ldl_solve(direct, b, z, out):
+    """Solve A out = b for three right-hand sides (columns) with the Direct factor; z is
+    scratch."""
+    Lp, Li, Lx, dinv, perm = direct
     n = b.shape[0]
     for i in range(n):
         r = perm[i]
@@ -136,13 +196,18 @@ def ldl_solve(Lp, Li, Lx, dinv, perm, b, z, out):
 
 
 @njit(cache=True)
-def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
-    """Project points inside a sphere (centre c m, velocity vc m/s) out to radius + thickness
-    (radially; a point that crossed the centre since the step's start xn goes back out on
-    that side, not out the far side), remove their inward normal velocity relative to the sphere and apply Coulomb friction to the
-    tangential one. Adds the impulse and angular impulse on the sphere (N s, N m s) to imp[0:6];
-    returns the impulse magnitude."""
-    reach = radius + thickness
+def _sphere_contacts(pts, xn, ball, law, h, imp):
+    """The contact law on the points inside a sphere (a contact.Sphere: centre and velocity at
+    the step's end) after a step of h (s): each point's normal velocity changes by the law's
+    backward-Euler response and its position with it (x += h dv n, so x - x_n = h v still
+    holds), then the law's sliding friction acts on its slip relative to the sphere. A point
+    that crossed the centre since the step's start xn goes back out on that side. Adds the
+    impulse and the angular impulse about the centre the points exert on the sphere (N s,
+    N m s) to imp[0:6]; returns the impulse magnitude."""
+    x, v, m, fixed = pts
+    c, vc = ball.c, ball.v
+    reach = ball.radius + law[THICKNESS]
+    cs, cd, mu, eps = law[STIFFNESS], law[DAMPING], law[FRICTION], law[EPS]
     J0 = 0.0
     J1 = 0.0
     J2 = 0.0
@@ -159,33 +224,39 @@ def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
         s1 = xn[i, 1] - c[1]
         s2 = xn[i, 2] - c[2]
         if r0 * s0 + r1 * s1 + r2 * s2 <= 0.0:
-            r0, r1, r2 = s0, s1, s2
-            dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
-        if dist <= 0.0:
+            sd = np.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+            if sd <= 0.0:
+                continue
+            n0, n1, n2 = s0 / sd, s1 / sd, s2 / sd
+            dist = r0 * n0 + r1 * n1 + r2 * n2  # <= 0: it is past the centre along n
+        elif dist > 0.0:
+            n0, n1, n2 = r0 / dist, r1 / dist, r2 / dist
+        else:
             continue
-        n0 = r0 / dist
-        n1 = r1 / dist
-        n2 = r2 / dist
-        x[i, 0] = c[0] + reach * n0
-        x[i, 1] = c[1] + reach * n1
-        x[i, 2] = c[2] + reach * n2
         u0 = v[i, 0] - vc[0]
         u1 = v[i, 1] - vc[1]
         u2 = v[i, 2] - vc[2]
         un = u0 * n0 + u1 * n1 + u2 * n2
-        if un >= 0.0:
+        dvn = backward_euler_normal(reach - dist, un, m[i], h, cs, cd)
+        if dvn <= 0.0:
             continue
         t0 = u0 - un * n0
         t1 = u1 - un * n1
         t2 = u2 - un * n2
         ut = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-        keep = 0.0 if ut <= 0.0 else max(0.0, 1.0 - mu * (-un) / ut)
-        dv0 = -un * n0 + (keep - 1.0) * t0
-        dv1 = -un * n1 + (keep - 1.0) * t1
-        dv2 = -un * n2 + (keep - 1.0) * t2
+        slow = 0.0  # the slip's change of speed (m/s) from friction over the step
+        if ut > 0.0:
+            slow = sliding_friction(m[i] * dvn / h, ut, mu, eps, 1.0 / m[i], h) * h / m[i]
+        keep = 0.0 if ut <= 0.0 else 1.0 - slow / ut
+        dv0 = dvn * n0 + (keep - 1.0) * t0
+        dv1 = dvn * n1 + (keep - 1.0) * t1
+        dv2 = dvn * n2 + (keep - 1.0) * t2
         v[i, 0] += dv0
         v[i, 1] += dv1
         v[i, 2] += dv2
+        x[i, 0] += h * dvn * n0
+        x[i, 1] += h * dvn * n1
+        x[i, 2] += h * dvn * n2
         j0 = -m[i] * dv0
         j1 = -m[i] * dv1
         j2 = -m[i] * dv2
@@ -203,11 +274,11 @@ def _collide(x, xn, v, m, fixed, c, vc, radius, thickness, mu, imp):
 
 
 @njit(cache=True)
-def _energy_gradient(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, g):
-    """Phi (J s^2, up to a constant) at x (all points, fixed ones at their places) and its
-    gradient g over the unknowns (N s^2). u (ns, 3), cn (ns,): each spring's unit direction at
-    the step's start and u . d there (m; a slack or degenerate spring has u = 0); hh = h^2,
-    hb = h beta (s^2)."""
+def _energy_gradient(x, obj, g):
+    """Phi (J s^2, up to a constant) of the Objective at x (all points, fixed ones at their
+    places) and its gradient g over the unknowns (N s^2). A slack or degenerate spring has
+    u = 0 (it damps nothing)."""
+    fid, diag, base = obj.fid, obj.diag, obj.base
     phi = 0.0
     for i in range(x.shape[0]):
         p = fid[i]
@@ -216,14 +287,14 @@ def _energy_gradient(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh,
         for r in range(3):
             g[p, r] = diag[p] * x[i, r] - base[p, r]
             phi += 0.5 * diag[p] * x[i, r] * x[i, r] - base[p, r] * x[i, r]
-    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, u, cn, hh, hb, g)
+    return phi + _spring_terms(x, obj, g)
 
 
 @njit(cache=True)
-def _energy_gradient_along(x0, q, t, x, fid, si, sj, l0, k, tension_only, u, cn, diag, base,
-                           hh, hb, g):
+def _energy_gradient_along(x0, q, t, x, obj, g):
     """``_energy_gradient`` at x = x0 - t q (q over the unknowns; fixed points stay), which
     is written to x: the line search's trial point in the same pass."""
+    fid, diag, base = obj.fid, obj.diag, obj.base
     phi = 0.0
     for i in range(x.shape[0]):
         p = fid[i]
@@ -236,13 +307,16 @@ def _energy_gradient_along(x0, q, t, x, fid, si, sj, l0, k, tension_only, u, cn,
             x[i, r] = xi
             g[p, r] = diag[p] * xi - base[p, r]
             phi += 0.5 * diag[p] * xi * xi - base[p, r] * xi
-    return phi + _spring_terms(x, fid, si, sj, l0, k, tension_only, u, cn, hh, hb, g)
+    return phi + _spring_terms(x, obj, g)
 
 
 @njit(cache=True)
-def _spring_terms(x, fid, si, sj, l0, k, tension_only, u, cn, hh, hb, g):
+def _spring_terms(x, obj, g):
     """The springs' part of Phi at x (stretch energy and lagged along-spring damping), their
     gradient added to g."""
+    fid, u, cn, hh, hb = obj.fid, obj.u, obj.cn, obj.hh, obj.hb
+    si, sj, l0, k, tension_only = (obj.springs.i, obj.springs.j, obj.springs.rest,
+                                   obj.springs.k, obj.springs.tension_only)
     phi = 0.0
     for s in range(si.shape[0]):
         a = si[s]
@@ -289,24 +363,25 @@ def _axpy_dot(q, a, y, s):
 
 
 @njit(cache=True)
-def _lbfgs(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, iters, tol,
-           direct, mg, S, Y, rho, count, g, gn, q, z, xt, phis):
-    """Minimize Phi by L-BFGS with A as the initial Hessian (Liu, Bouaziz & Kavan 2017; its
-    inverse applied by ``_apply_h0``) and a backtracking Armijo line search. S, Y (mem + 1,
-    nf, 3) are a ring of position and gradient changes, rho their 1 / s.y, count[0] the pairs
-    stored so far: the last min(count, mem) are live, and the slot after them is where the
-    next pair is written (kept only if its curvature s.y is positive). Stops after ``iters``
+def _lbfgs(x, obj, pre, hist, work, iters, tol, phis):
+    """Minimize the Objective's Phi by L-BFGS with A as the initial Hessian (Liu, Bouaziz &
+    Kavan 2017; its inverse applied by ``_apply_h0`` with the Factors ``pre``) and a
+    backtracking Armijo line search. hist: the History ring; the last min(count, mem) pairs
+    are live, and the slot after them is where the next pair is written (kept only if its
+    curvature s.y is positive). work: (g, gn, q, z, xt) scratch. Stops after ``iters``
     iterations or when an iteration moves no point by more than tol times the first
     iteration's largest move. Returns the iterations taken; phis[0], phis[1] receive Phi at
     the first guess and at the end. Vector passes are fused: this is memory-bound."""
+    S, Y, rho, count = hist
+    g, gn, q, z, xt = work
+    fid = obj.fid
     slots = S.shape[0]
     mem = slots - 1
     alpha = np.empty(slots)
     cur, trial = x, xt
     gc, gt = g, gn
     swapped = False  # cur is xt
-    phi = _energy_gradient_along(x, q, 0.0, trial, fid, si, sj, l0, k, tension_only, u, cn,
-                                 diag, base, hh, hb, gc)
+    phi = _energy_gradient_along(x, q, 0.0, trial, obj, gc)
     phis[0] = phi
     phis[1] = phi
     stored = count[0]
@@ -326,7 +401,7 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, iters
             alpha[c] = rho[c] * acc
             older = (stored - 2 - j) % slots  # the next pair's s . q, fused (unused at the end)
             acc = _axpy_dot(q, alpha[c], Y[c], S[older] if j + 1 < live else Y[c])
-        _apply_h0(direct, mg, q, z)
+        _apply_h0(pre, q, z)
         acc = 0.0
         if live > 0:
             acc = _dot(Y[(stored - live) % slots], q)
@@ -341,8 +416,7 @@ def _lbfgs(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, iters
             break
         t = 1.0
         for _ in range(12):
-            phin = _energy_gradient_along(cur, q, t, trial, fid, si, sj, l0, k, tension_only,
-                                          u, cn, diag, base, hh, hb, gt)
+            phin = _energy_gradient_along(cur, q, t, trial, obj, gt)
             # Armijo, with room for round-off in Phi's large constant parts
             if phin <= phi + 1e-4 * t * slope + 1e-13 * abs(phi):
                 break
@@ -392,26 +466,29 @@ def _dot(a, b):
 
 
 @njit(cache=True)
-def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a_k, a_c,
-                      alpha, beta, gravity, fext, h, nsteps, iters, tol,
-                      direct, mg, S, Y, rhos, count, centres, velocities, accels, radii, params,
-                      impulses, phis):
-    """nsteps backward-Euler steps of h seconds with fext (N) held; returns the iterations
-    taken in all.
+def localglobal_steps(net, fext, pre, hist, settings, h, nsteps, cols, phis):
+    """nsteps backward-Euler steps of h seconds of a springs.Network with fext (N) held;
+    returns the iterations taken in all.
 
-    fid: each point's index among the unknowns, -1 for fixed points; direct: ``factor``'s
-    arrays, or mg: a multigrid hierarchy and workspace (the other one ``NO_DIRECT`` /
-    ``NO_MULTIGRID``). Each step runs ``_lbfgs`` (at most ``iters`` iterations, stopping
-    early when an iteration moves no point by more than tol times the first one did) with the
-    pairs S, Y (memory + 1, nf, 3), their 1 / s.y in rhos and count[0] pairs stored so far,
-    kept from step to step and call to call (the stretch energy's curvature, which the pairs
-    learn, depends on x only; the linear part and the damping directions change, so old pairs
-    are a good, not an exact, model); memory 0 gives plain local/global iterations. Spheres (k): centres, velocities, accels (k,3) move along c0 + v t + a t^2/2
-    over the nsteps; radii (k,); params (k,6) as for the network's moving spheres (thickness
-    and mu are used: the contact is a projection); impulses (k,7) receives impulse, angular
-    impulse and peak force (N). phis (2,) receives the objective (J s^2, up to a constant) at
-    the last step's first guess and at its end, before any sphere: how far the iterations got.
+    pre: the Factors of A for step h; each step runs ``_lbfgs`` (Settings: at most ``iters``
+    iterations, stopping early when an iteration moves no point by more than tol times the
+    first one did) with the History ``hist``, kept from step to step and call to call (the
+    stretch energy's curvature, which the pairs learn, depends on x only; the linear part and
+    the damping directions change, so old pairs are a good, not an exact, model); memory 0
+    gives plain local/global iterations. cols: sub-cycled contact.Colliders (none: zero rows),
+    moving along c0 + v t + a t^2/2 over the nsteps and acting on the points after every step
+    (``_sphere_contacts``); cols.impulses receives impulse, angular impulse and peak force (N).
+    phis (2,) receives the objective (J s^2, up to a constant) at the last step's first guess
+    and at its end, before any collider: how far the iterations got.
     """
+    x, v, m, _ = net.pts
+    si, sj, l0, tension_only = (net.springs.i, net.springs.j, net.springs.rest,
+                                net.springs.tension_only)
+    a_idx, a_pos, a_k, a_c = net.anchors
+    alpha, gravity = net.alpha, net.gravity
+    beta, iters, tol = settings
+    fid = pre.fid
+    impulses = cols.impulses
     n = x.shape[0]
     nf = int(np.sum(fid >= 0))
     ns = si.shape[0]
@@ -436,7 +513,7 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
     c = np.empty(3)
     vc = np.empty(3)
     imp = np.zeros(6)
-    fixed = fid < 0
+    pts = Points(x, v, m, fid < 0)
     total = 0
     for j in range(impulses.shape[0]):
         for r in range(7):
@@ -477,21 +554,22 @@ def localglobal_steps(x, v, m, fid, si, sj, l0, k, tension_only, a_idx, a_pos, a
                 u[s, 1] = 0.0
                 u[s, 2] = 0.0
                 cn[s] = 0.0
-        total += _lbfgs(x, fid, si, sj, l0, k, tension_only, u, cn, diag, base, hh, hb, iters,
-                        tol, direct, mg, S, Y, rhos, count, g, gn, q, z, xt, phis)
+        obj = Objective(fid, net.springs, u, cn, diag, base, hh, hb)
+        total += _lbfgs(x, obj, pre, hist, (g, gn, q, z, xt), iters, tol, phis)
         for i in range(n):
             if fid[i] >= 0:
                 for r in range(3):
                     v[i, r] = (x[i, r] - xn[i, r]) / h
         tau = (step + 1) * h
-        for j in range(centres.shape[0]):
+        for j in range(cols.centres.shape[0]):
             for r in range(3):
-                c[r] = centres[j, r] + velocities[j, r] * tau + 0.5 * accels[j, r] * tau * tau
-                vc[r] = velocities[j, r] + accels[j, r] * tau
+                c[r] = (cols.centres[j, r] + cols.velocities[j, r] * tau
+                        + 0.5 * cols.accels[j, r] * tau * tau)
+                vc[r] = cols.velocities[j, r] + cols.accels[j, r] * tau
                 imp[r] = 0.0
                 imp[r + 3] = 0.0
-            jm = _collide(x, xn, v, m, fixed, c, vc, radii[j], params[j, 0], params[j, 3],
-                          imp)
+            ball = Sphere(c, vc, cols.spins[j], cols.radii[j], cols.masses[j], cols.accels[j])
+            jm = _sphere_contacts(pts, xn, ball, cols.law[j], h, imp)
             for r in range(6):
                 impulses[j, r] += imp[r]
             if jm / h > impulses[j, 6]:

@@ -99,11 +99,18 @@ def hierarchy(A, max_coarse=300):
                      np.concatenate(wdinv), np.ascontiguousarray(Lc))
 
 
-def workspace(hier):
-    """Scratch for ``vcycle``: three (roff[L], 3) stacked level vectors (the guesses, the
-    corrected guesses and the right-hand sides), allocated once."""
+class Workspace(NamedTuple):
+    """Scratch for ``vcycle``: three (roff[L], 3) stacked level vectors, the guesses X, the
+    corrected guesses Y and the right-hand sides B."""
+    X: np.ndarray
+    Y: np.ndarray
+    B: np.ndarray
+
+
+def workspace(hier) -> Workspace:
+    """``vcycle``'s scratch for a hierarchy, allocated once."""
     rows = int(hier.roff[-1])
-    return np.zeros((rows, 3)), np.zeros((rows, 3)), np.zeros((rows, 3))
+    return Workspace(np.zeros((rows, 3)), np.zeros((rows, 3)), np.zeros((rows, 3)))
 
 
 @njit(cache=True)
@@ -117,9 +124,10 @@ def _scale(wdinv, o, b, x):
 
 
 @njit(cache=True)
-def _restrict_residual(Ap, Ai, Ax, Pp, Pi, Px, o, b, x, bc):
+def _restrict_residual(hier, o, b, x, bc):
     """bc = P^T (b - A x), P^T applied by scattering each fine row's residual: fused, so A and P
     are each streamed once and the residual is never stored."""
+    Ap, Ai, Ax, Pp, Pi, Px = hier.Ap, hier.Ai, hier.Ax, hier.Pp, hier.Pi, hier.Px
     bc[:] = 0.0
     for i in range(x.shape[0]):
         s0 = b[i, 0]
@@ -206,17 +214,19 @@ def _cholesky_solve(Lc, b, x):
 
 
 @njit(cache=True)
-def vcycle(sizes, roff, Ap, Ai, Ax, Pp, Pi, Px, wdinv, Lc, X, Y, B, b, out):
+def vcycle(hier, work, b, out):
     """out (n, 3) = one V-cycle on A out = b (n, 3) from a zero guess: a symmetric positive
-    definite approximation of A^-1 b (units of b over A's). The hierarchy's arrays, then
-    ``workspace``'s X, Y, B; out must not alias b. Allocates nothing."""
+    definite approximation of A^-1 b (units of b over A's). hier: a Hierarchy, work: its
+    Workspace; out must not alias b. Allocates nothing."""
+    sizes, roff, Ap, Ai, Ax, Pp, Pi, Px, wdinv, Lc = hier
+    X, Y, B = work
     L = sizes.shape[0]
     for l in range(L - 1):
         o = roff[l]
         bl = b if l == 0 else B[o:o + sizes[l]]
         x = X[o:o + sizes[l]]
         _scale(wdinv, o, bl, x)
-        _restrict_residual(Ap, Ai, Ax, Pp, Pi, Px, o, bl, x, B[roff[l + 1]:roff[l + 2]])
+        _restrict_residual(hier, o, bl, x, B[roff[l + 1]:roff[l + 2]])
     oc = roff[L - 1]
     if L == 1:
         _cholesky_solve(Lc, b, out)

@@ -32,63 +32,58 @@ def adjacency(n, si, sj, a_idx):
     return indptr, ids, sign, a_ptr, a_ids, np.empty((len(si), 3))
 
 
-@njit(cache=True, inline="always")
-def _spring_force(s, x, v, si, sj, l0, k, kd, tension_only, fs):
-    """fs[s] (N): the force of spring s on its point si[s] (minus it on sj[s])."""
-    a = si[s]
-    b = sj[s]
-    d0 = x[a, 0] - x[b, 0]
-    d1 = x[a, 1] - x[b, 1]
-    d2 = x[a, 2] - x[b, 2]
-    l2 = d0 * d0 + d1 * d1 + d2 * d2
-    if l2 <= 0.0 or (tension_only[s] and l2 < l0[s] * l0[s]):
-        fs[s, 0] = 0.0
-        fs[s, 1] = 0.0
-        fs[s, 2] = 0.0
-        return
-    inv = 1.0 / np.sqrt(l2)
-    vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1 + (v[a, 2] - v[b, 2]) * d2) * inv
-    mag = (-k[s] * (l2 * inv - l0[s]) - kd[s] * vr) * inv
-    fs[s, 0] = mag * d0
-    fs[s, 1] = mag * d1
-    fs[s, 2] = mag * d2
-
-
-@njit(cache=True, inline="always")
-def _gather_point(p, x, v, m, alpha, gravity, fext, indptr, ids, sign, fs, a_ptr, a_ids, a_pos,
-                  a_k, a_c, f):
-    """f[p]: external, gravity, mass damping, the incident springs' forces and p's anchors."""
-    f0 = fext[p, 0] + m[p] * (gravity[0] - alpha * v[p, 0])
-    f1 = fext[p, 1] + m[p] * (gravity[1] - alpha * v[p, 1])
-    f2 = fext[p, 2] + m[p] * (gravity[2] - alpha * v[p, 2])
-    for e in range(indptr[p], indptr[p + 1]):
-        s = ids[e]
-        g = sign[e]
-        f0 += g * fs[s, 0]
-        f1 += g * fs[s, 1]
-        f2 += g * fs[s, 2]
-    for e in range(a_ptr[p], a_ptr[p + 1]):
-        r = a_ids[e]
-        f0 += -a_k[r] * (x[p, 0] - a_pos[r, 0]) - a_c[r] * v[p, 0]
-        f1 += -a_k[r] * (x[p, 1] - a_pos[r, 1]) - a_c[r] * v[p, 1]
-        f2 += -a_k[r] * (x[p, 2] - a_pos[r, 2]) - a_c[r] * v[p, 2]
-    f[p, 0] = f0
-    f[p, 1] = f1
-    f[p, 2] = f2
-
-
 @njit(cache=True, parallel=True)
-def explicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_pos, a_k, a_c, alpha,
-                  gravity, fext, f, h, nsteps, adj):
-    """``springs.explicit_step`` (nsteps symplectic-Euler steps of h s) with parallel forces:
-    two parallel loops a step, per spring then per point (gather and update fused)."""
+def explicit_step(net, fext, f, h, nsteps, adj):
+    """``springs.explicit_step`` (nsteps symplectic-Euler steps of h s on a springs.Network)
+    with parallel forces: two parallel loops a step, per spring then per point (gather and
+    update fused). adj: ``adjacency``'s arrays. (The loop bodies read plain arrays: Numba's
+    parallel loops cannot take the bundles themselves.)"""
+    x, v, m, fixed = net.pts
+    si, sj, l0, k, kd, tension_only = net.springs
+    a_pos, a_k, a_c = net.anchors.pos, net.anchors.k, net.anchors.c
+    alpha, gravity = net.alpha, net.gravity
     indptr, ids, sign, a_ptr, a_ids, fs = adj
+    g0, g1, g2 = gravity[0], gravity[1], gravity[2]
     for _ in range(nsteps):
         for s in prange(si.shape[0]):
-            _spring_force(s, x, v, si, sj, l0, k, kd, tension_only, fs)
+            # fs[s] (N): the force of spring s on its point si[s] (minus it on sj[s])
+            a = si[s]
+            b = sj[s]
+            d0 = x[a, 0] - x[b, 0]
+            d1 = x[a, 1] - x[b, 1]
+            d2 = x[a, 2] - x[b, 2]
+            l2 = d0 * d0 + d1 * d1 + d2 * d2
+            if l2 <= 0.0 or (tension_only[s] and l2 < l0[s] * l0[s]):
+                fs[s, 0] = 0.0
+                fs[s, 1] = 0.0
+                fs[s, 2] = 0.0
+                continue
+            inv = 1.0 / np.sqrt(l2)
+            vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1
+                  + (v[a, 2] - v[b, 2]) * d2) * inv
+            mag = (-k[s] * (l2 * inv - l0[s]) - kd[s] * vr) * inv
+            fs[s, 0] = mag * d0
+            fs[s, 1] = mag * d1
+            fs[s, 2] = mag * d2
         for p in prange(x.shape[0]):
-            _gather_point(p, x, v, m, alpha, gravity, fext, indptr, ids, sign, fs, a_ptr,
-                          a_ids, a_pos, a_k, a_c, f)
+            # external, gravity, mass damping, the incident springs' forces and p's anchors
+            f0 = fext[p, 0] + m[p] * (g0 - alpha * v[p, 0])
+            f1 = fext[p, 1] + m[p] * (g1 - alpha * v[p, 1])
+            f2 = fext[p, 2] + m[p] * (g2 - alpha * v[p, 2])
+            for e in range(indptr[p], indptr[p + 1]):
+                q = ids[e]
+                sg = sign[e]
+                f0 += sg * fs[q, 0]
+                f1 += sg * fs[q, 1]
+                f2 += sg * fs[q, 2]
+            for e in range(a_ptr[p], a_ptr[p + 1]):
+                r = a_ids[e]
+                f0 += -a_k[r] * (x[p, 0] - a_pos[r, 0]) - a_c[r] * v[p, 0]
+                f1 += -a_k[r] * (x[p, 1] - a_pos[r, 1]) - a_c[r] * v[p, 1]
+                f2 += -a_k[r] * (x[p, 2] - a_pos[r, 2]) - a_c[r] * v[p, 2]
+            f[p, 0] = f0
+            f[p, 1] = f1
+            f[p, 2] = f2
             if fixed[p]:
                 continue
             for c in range(3):

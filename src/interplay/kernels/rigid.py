@@ -1,8 +1,32 @@
 """Rigid-body integration kernels (quaternions are (w, x, y, z); angular velocity in world frame)."""
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from .springs import inv3
+
+
+class Body(NamedTuple):
+    """A rigid body's state and constants: position x (3,) m, velocity v (3,) m/s, orientation
+    q (4,) w, x, y, z, angular velocity w (3,) rad/s in the world frame, mass (kg), principal
+    inertia (3,) kg m^2 in the body frame, gravity (3,) m/s^2."""
+    x: np.ndarray
+    v: np.ndarray
+    q: np.ndarray
+    w: np.ndarray
+    mass: float
+    inertia: np.ndarray
+    gravity: np.ndarray
+
+
+class Wrench(NamedTuple):
+    """The force (3,) N and torque about the centre (3,) N m held over a step, and the force's
+    Jacobians kext = dF/dx (3,3) N/m and dext = dF/dv (3,3) N s/m (zero when it has none)."""
+    force: np.ndarray
+    torque: np.ndarray
+    kext: np.ndarray
+    dext: np.ndarray
 
 
 @njit(cache=True)
@@ -27,8 +51,8 @@ def quat_to_matrix(q):
 
 
 @njit(cache=True)
-def rigid_step(x, v, q, w, force, torque, kext, dext, gravity, mass, inertia_body, h):
-    """Advance one rigid body by h under a force and torque held constant over the step.
+def rigid_step(body, wrench, h):
+    """Advance one rigid Body by h under a Wrench held constant over the step.
 
     Translation uses x += h v + h^2 a / 2, v += h a: exact for constant acceleration (ballistic
     flight is reproduced to round-off) and second order otherwise. When the force comes with
@@ -40,6 +64,8 @@ def rigid_step(x, v, q, w, force, torque, kext, dext, gravity, mass, inertia_bod
     Rotation integrates Euler's equations explicitly in the world frame and applies the exact
     rotation exp(h w) to q. Arrays are updated in place.
     """
+    x, v, q, w, mass, inertia_body, gravity = body
+    force, torque, kext, dext = wrench
     stiff = False
     for i in range(3):
         for j in range(3):

@@ -8,8 +8,89 @@ are zero-rest-length springs from a point to a world position (k N/m, c N s/m); 
 the mass-proportional Rayleigh coefficient (force -alpha m v). ``fixed`` points never move: the
 implicit solve filters them out of the system (constraint filter), the explicit step skips them.
 """
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+
+class Points(NamedTuple):
+    """A network's point state: x, v (n,3) m and m/s, m (n,) kg, fixed (n,) bool."""
+    x: np.ndarray
+    v: np.ndarray
+    m: np.ndarray
+    fixed: np.ndarray
+
+
+class SpringSet(NamedTuple):
+    """Springs from point i to point j: rest length (m), stiffness k (N/m), along-spring
+    damping kd (N s/m), tension_only (cords that go slack)."""
+    i: np.ndarray
+    j: np.ndarray
+    rest: np.ndarray
+    k: np.ndarray
+    kd: np.ndarray
+    tension_only: np.ndarray
+
+
+class Anchors(NamedTuple):
+    """Zero-rest-length springs from points idx to world positions pos (a,3) m, stiffness
+    k (N/m) and damping c (N s/m)."""
+    idx: np.ndarray
+    pos: np.ndarray
+    k: np.ndarray
+    c: np.ndarray
+
+
+class Network(NamedTuple):
+    """Everything the network kernels read: points, springs, anchors, mass damping alpha (1/s)
+    and gravity (3,) m/s^2."""
+    pts: Points
+    springs: SpringSet
+    anchors: Anchors
+    alpha: float
+    gravity: np.ndarray
+
+
+class Load(NamedTuple):
+    """The external forces held over a step: f (n,3) N and their Jacobian blocks kext = df/dx
+    (n,3,3) N/m, dext = df/dv (n,3,3) N s/m, and kvref (n,3) the sum of kext v_ref over the
+    forces relative to another body moving at v_ref (N/s)."""
+    f: np.ndarray
+    kext: np.ndarray
+    dext: np.ndarray
+    kvref: np.ndarray
+
+
+class Scheme(NamedTuple):
+    """How a network steps: implicit (else symplectic Euler); theta (the theta-method's
+    weight) or bdf2; tol and max_iter of the CG solve; xp, vp (n,3) the previous step's state
+    (BDF2's history)."""
+    implicit: bool
+    theta: float
+    bdf2: bool
+    tol: float
+    max_iter: int
+    xp: np.ndarray
+    vp: np.ndarray
+
+
+class PointForces(NamedTuple):
+    """Forces on points, as a contact writes them: idx (c,) point indices, f (c,3) N, their
+    Jacobians dfdx (c,3,3) N/m and dfdv (c,3,3) N s/m, and vref (c,3) m/s the velocity of
+    the body each force is relative to."""
+    idx: np.ndarray
+    f: np.ndarray
+    dfdx: np.ndarray
+    dfdv: np.ndarray
+    vref: np.ndarray
+
+
+def point_forces(capacity: int) -> PointForces:
+    """An empty PointForces buffer for up to ``capacity`` entries."""
+    return PointForces(np.zeros(capacity, np.int64), np.zeros((capacity, 3)),
+                       np.zeros((capacity, 3, 3)), np.zeros((capacity, 3, 3)),
+                       np.zeros((capacity, 3)))
 
 
 @njit(cache=True, inline="always")
@@ -22,9 +103,12 @@ def _spring_vector(x, a, b):
 
 
 @njit(cache=True)
-def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
-                   alpha, gravity, fext, f):
+def network_forces(net, fext, f):
     """Total force (N) on each point: springs, anchors, Rayleigh mass damping, gravity, external."""
+    x, v, m, _ = net.pts
+    si, sj, l0, k, kd, tension_only = net.springs
+    a_idx, a_pos, a_k, a_c = net.anchors
+    alpha, gravity = net.alpha, net.gravity
     n = x.shape[0]
     for p in range(n):
         for c in range(3):
@@ -56,8 +140,9 @@ def network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, 
 
 
 @njit(cache=True, inline="always")
-def symplectic_update(x, v, m, fixed, f, h):
+def symplectic_update(pts, f, h):
     """v += h f / m, then x += h v, for every free point."""
+    x, v, m, fixed = pts
     for p in range(x.shape[0]):
         if fixed[p]:
             continue
@@ -67,22 +152,21 @@ def symplectic_update(x, v, m, fixed, f, h):
 
 
 @njit(cache=True)
-def explicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
-                  alpha, gravity, fext, f, h, nsteps):
+def explicit_step(net, fext, f, h, nsteps):
     """nsteps symplectic-Euler steps of h seconds (v += h f/m, then x += h v), fext held."""
     for _ in range(nsteps):
-        network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
-                       alpha, gravity, fext, f)
-        symplectic_update(x, v, m, fixed, f, h)
+        network_forces(net, fext, f)
+        symplectic_update(net.pts, f, h)
 
 
 @njit(cache=True)
-def _spring_blocks(x, si, sj, l0, k, kd, tension_only, h, C, Kblk):
+def _spring_blocks(x, springs, h, C, Kblk):
     """Per-spring blocks: Kblk = d f_a / d x_a, C = h D_s + h^2 K_s (negative semidefinite).
 
     The transverse term k (1 - l0/l) is clamped at zero for compressed springs so the system
     stays positive definite (Baraff & Witkin's advice); slack tension-only cords contribute 0.
     """
+    si, sj, l0, k, kd, tension_only = springs
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
@@ -158,9 +242,7 @@ def _dot(a, b):
 
 
 @njit(cache=True)
-def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
-                  alpha, gravity, fext, kext, dext, kvref, f, h, theta, bdf2, has_prev, xp, vp,
-                  tol, max_iter):
+def implicit_step(net, load, f, h, scheme, has_prev):
     """One implicit step with one Newton iteration, of the theta-method or of BDF2.
 
     theta-method: (M - theta h D - theta^2 h^2 K) dv = h (f + theta h K v),
@@ -181,10 +263,15 @@ def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
     point follows the other body through the step instead of lagging a step behind. Solved by
     block-Jacobi preconditioned CG to a relative residual ``tol``. Returns the CG iterations.
     """
+    x, v, m, fixed = net.pts
+    si, sj = net.springs.i, net.springs.j
+    a_idx, a_k, a_c = net.anchors.idx, net.anchors.k, net.anchors.c
+    alpha = net.alpha
+    fext, kext, dext, kvref = load
+    _, theta, bdf2, tol, max_iter, xp, vp = scheme
     n = x.shape[0]
     ns = si.shape[0]
-    network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
-                   alpha, gravity, fext, f)
+    network_forces(net, fext, f)
     C = np.empty((ns, 3, 3))
     Kblk = np.empty((ns, 3, 3))
     first = bdf2 and not has_prev
@@ -201,7 +288,7 @@ def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
             # fixed points never move (and their xp is never recorded): y = 0 there
             y[i, r] = 0.0 if fixed[i] else (
                 hs * v[i, r] + (cprev * (x[i, r] - xp[i, r]) if bdf2 else 0.0))
-    _spring_blocks(x, si, sj, l0, k, kd, tension_only, hs, C, Kblk)
+    _spring_blocks(x, net.springs, hs, C, Kblk)
     # diagonal blocks of A not coming from springs: M - h D_diag - h^2 K_diag
     diag = np.zeros((n, 3, 3))
     for i in range(n):
@@ -299,8 +386,9 @@ def implicit_step(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
 
 
 @njit(cache=True)
-def max_strain(x, si, sj, l0):
+def max_strain(x, springs):
     """Largest (l - l0) / l0 over all springs."""
+    si, sj, l0 = springs.i, springs.j, springs.rest
     best = -1.0
     for s in range(si.shape[0]):
         e = _spring_vector(x, si[s], sj[s])[3] / l0[s] - 1.0
@@ -310,9 +398,12 @@ def max_strain(x, si, sj, l0):
 
 
 @njit(cache=True)
-def scatter_forces(idx, forces, dfdx, dfdv, vref, fext, kext, dext, kvref, with_jacobian):
-    """Accumulate point forces, their 3x3 Jacobian blocks and kext v_ref into the buffers."""
-    for r in range(idx.shape[0]):
+def scatter_forces(forces, count, load, with_jacobian):
+    """Accumulate the first ``count`` point forces (a PointForces), with their 3x3 Jacobian
+    blocks and kext v_ref when ``with_jacobian``, into the held load."""
+    idx, forces, dfdx, dfdv, vref = forces
+    fext, kext, dext, kvref = load
+    for r in range(count):
         p = idx[r]
         for c in range(3):
             fext[p, c] += forces[r, c]
@@ -324,90 +415,3 @@ def scatter_forces(idx, forces, dfdx, dfdv, vref, fext, kext, dext, kvref, with_
                     dext[p, a, c] += dfdv[r, a, c]
                     kv += dfdx[r, a, c] * vref[r, c]
                 kvref[p, a] += kv
-
-
-@njit(cache=True)
-def explicit_step_point_spheres(x, v, m, fixed, si, sj, l0, k, kd, tension_only, a_idx, a_pos,
-                                a_k, a_c, alpha, gravity, fext, f, h, nsub, centres, velocities,
-                                spins, accels, radii, masses, params, impulses):
-    """nsub symplectic-Euler substeps of h/nsub s against moving spheres touching the *points*.
-
-    The contact law is ``contact.sphere_segments``' with the segment shrunk to a point: penalty
-    c_s pen - c_d v_n along the normal, regularized Coulomb friction capped at the force that
-    stops the slip within a substep; no Jacobians (explicit). One test per point instead of per
-    spring: for cloth (~3 springs a point) the segment test dominated the explicit step.
-    Spheres as in ``subcycle.substep_with_spheres``: centres, velocities, spins, accels (q,3)
-    along c0 + v t + a t^2/2; radii, masses (q,); params (q,6) thickness m, c_s N/m,
-    c_d N s/m, mu, eps m/s, constraint 0/1; impulses (q,7) receives the impulse (N s), angular
-    impulse (N m s) on each sphere and its peak force (N).
-    """
-    dt = h / nsub
-    n = x.shape[0]
-    for q in range(impulses.shape[0]):
-        for r in range(7):
-            impulses[q, r] = 0.0
-    for step in range(nsub):
-        tau = step * dt
-        network_forces(x, v, m, si, sj, l0, k, kd, tension_only, a_idx, a_pos, a_k, a_c,
-                       alpha, gravity, fext, f)
-        for q in range(centres.shape[0]):
-            c0 = centres[q, 0] + velocities[q, 0] * tau + 0.5 * accels[q, 0] * tau * tau
-            c1 = centres[q, 1] + velocities[q, 1] * tau + 0.5 * accels[q, 1] * tau * tau
-            c2 = centres[q, 2] + velocities[q, 2] * tau + 0.5 * accels[q, 2] * tau * tau
-            vq0 = velocities[q, 0] + accels[q, 0] * tau
-            vq1 = velocities[q, 1] + accels[q, 1] * tau
-            vq2 = velocities[q, 2] + accels[q, 2] * tau
-            w0, w1, w2 = spins[q, 0], spins[q, 1], spins[q, 2]
-            radius = radii[q]
-            reach = radius + params[q, 0]
-            cs, cd, mu, eps = params[q, 1], params[q, 2], params[q, 3], params[q, 4]
-            F0 = F1 = F2 = T0 = T1 = T2 = 0.0
-            for p in range(n):
-                dx = c0 - x[p, 0]
-                dy = c1 - x[p, 1]
-                dz = c2 - x[p, 2]
-                d2 = dx * dx + dy * dy + dz * dz
-                if d2 >= reach * reach or d2 <= 0.0:
-                    continue
-                dist = np.sqrt(d2)
-                n0, n1, n2 = dx / dist, dy / dist, dz / dist  # from the point to the centre
-                r0, r1, r2 = -radius * n0, -radius * n1, -radius * n2
-                # the ball's surface velocity at the contact relative to the point
-                u0 = vq0 + w1 * r2 - w2 * r1 - v[p, 0]
-                u1 = vq1 + w2 * r0 - w0 * r2 - v[p, 1]
-                u2 = vq2 + w0 * r1 - w1 * r0 - v[p, 2]
-                vn = u0 * n0 + u1 * n1 + u2 * n2
-                fn = cs * (reach - dist) - cd * vn
-                inv_m = 1.0 / masses[q] + 1.0 / m[p]
-                if params[q, 5] > 0.5:
-                    an = ((accels[q, 0] - f[p, 0] / m[p]) * n0 + (accels[q, 1] - f[p, 1] / m[p])
-                          * n1 + (accels[q, 2] - f[p, 2] / m[p]) * n2)
-                    if an < 0.0:
-                        fn += -an / inv_m
-                if fn <= 0.0:
-                    continue
-                t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-                vtn = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-                ft = 0.0
-                if vtn > 0.0:
-                    ft = -min(mu * fn * min(1.0, vtn / eps), vtn / (inv_m * dt)) / vtn
-                G0 = fn * n0 + ft * t0  # force on the ball; minus it on the point
-                G1 = fn * n1 + ft * t1
-                G2 = fn * n2 + ft * t2
-                f[p, 0] -= G0
-                f[p, 1] -= G1
-                f[p, 2] -= G2
-                F0 += G0
-                F1 += G1
-                F2 += G2
-                T0 += r1 * G2 - r2 * G1
-                T1 += r2 * G0 - r0 * G2
-                T2 += r0 * G1 - r1 * G0
-            impulses[q, 0] += F0 * dt
-            impulses[q, 1] += F1 * dt
-            impulses[q, 2] += F2 * dt
-            impulses[q, 3] += T0 * dt
-            impulses[q, 4] += T1 * dt
-            impulses[q, 5] += T2 * dt
-            impulses[q, 6] = max(impulses[q, 6], np.sqrt(F0 * F0 + F1 * F1 + F2 * F2))
-        symplectic_update(x, v, m, fixed, f, dt)

@@ -2,17 +2,38 @@
 
 Geometry: the closest point of a triangle, closest points of two segments, whether two
 triangles intersect, signed distances to a plane, box, sphere and capsule.
-Response (per contact): normal force f_n = f_c + c_s p - c_d pdot, clamped at zero (contacts
-push, never pull), where p is the penetration (m), pdot its rate, and f_c the constraint term
-that cancels the relative acceleration pushing the two together, f_c = -m_eff min(0, a_rel.n);
-friction is Coulomb: mu f_n against the slip while sliding (the regularized law
--mu f_n min(1, |v_t|/eps) v_t/|v_t| above eps), and static below the cone: a tangential spring
-to where the contact stuck, with the normal's stiffness and damping, which replaces the
-regularization's viscous range (there a block on a slope flatter than atan(mu) would creep at
-~eps tan(theta)/mu instead of sticking).
+Response (``respond``, per contact): the one contact law (``contact_law``): the stabilised
+penalty normal force with the constraint term, and Coulomb friction that sticks through a
+tangential spring below the cone (a block on a slope flatter than atan(mu) then holds instead
+of creeping), with stiffness and damping chosen from each contact's effective mass when not
+given.
 """
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, prange
+
+from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS
+from .contact_law import normal_force, sticking_friction
+
+
+class Contacts(NamedTuple):
+    """c contacts seen from their point side: n (c,3) unit normals towards it, pen (c,)
+    penetrations (m), vrel, arel (c,3) its velocity (m/s) and acceleration (m/s^2) relative to
+    the other side, inv_m (c,) the pair's inverse effective mass along n (1/kg)."""
+    n: np.ndarray
+    pen: np.ndarray
+    vrel: np.ndarray
+    arel: np.ndarray
+    inv_m: np.ndarray
+
+
+class ContactForces(NamedTuple):
+    """Forces on the point side of c contacts: f (c,3) N and their Jacobians with respect to
+    its position jx (c,3,3) N/m and velocity jv (c,3,3) N s/m."""
+    f: np.ndarray
+    jx: np.ndarray
+    jv: np.ndarray
 
 
 @njit(cache=True, inline="always")
@@ -217,59 +238,37 @@ def capsule_distance(pts, a, b, radius, out_s, out_n):
 
 
 @njit(cache=True)
-def respond(nrm, pen, vrel, arel, inv_m, stiffness, damping, omega, mu, eps, dt, constraint,
-            stretch, out_f, out_jx, out_jv):
-    """Forces on the point side of each contact (normal nrm towards it, penetration pen m,
-    relative velocity vrel and acceleration arel of the point side, inverse effective mass
-    inv_m 1/kg). stiffness (N/m) and damping (N s/m) < 0 choose them from the pair's mass and
-    the step: c_s = m_eff omega^2, c_d = 2 m_eff omega (critically damped: no bounce), omega
-    (rad/s) well below 1/dt so the held force stays stable. stretch (c,3) m: each contact's
-    tangential spring stretch, updated in place (zero for a new contact). Writes force and its
-    3x3 Jacobians (d/dx, d/dv of the point side); returns the active mask."""
+def respond(contacts, law, omega, dt, stretch, out):
+    """The contact law on each of the Contacts: writes force and its 3x3 Jacobians (d/dx, d/dv
+    of the point side) into the ContactForces ``out``; returns the active mask. law (6,): see
+    ``contact``; its STIFFNESS (N/m) and DAMPING (N s/m) < 0 choose them from the pair's mass
+    and the step: c_s = m_eff omega^2, c_d = 2 m_eff omega (critically damped: no bounce),
+    omega (rad/s) well below 1/dt (s) so the held force stays stable. stretch (c,3) m: each
+    contact's tangential spring, updated in place (zero for a new contact)."""
+    nrm, pen, vrel, arel, inv_m = contacts
+    out_f, out_jx, out_jv = out
+    stiffness, damping, mu, eps = law[STIFFNESS], law[DAMPING], law[FRICTION], law[EPS]
+    constraint = law[CONSTRAINT] > 0.5
     nc = nrm.shape[0]
     active = np.zeros(nc, np.bool_)
+    ft = np.empty(3)
     for i in range(nc):
         n = nrm[i]
         meff = 1.0 / inv_m[i]
         cs = stiffness if stiffness >= 0.0 else meff * omega * omega
         cd = damping if damping >= 0.0 else 2.0 * meff * omega
         vn = vrel[i] @ n
-        an = arel[i] @ n
-        fn = cs * pen[i] - cd * vn
-        if constraint and an < 0.0:
-            fn -= meff * an
+        fn = normal_force(pen[i], vn, arel[i] @ n, inv_m[i], cs, cd, constraint)
         out_f[i] = 0.0
         out_jx[i] = 0.0
         out_jv[i] = 0.0
         if fn <= 0.0:
             continue
         active[i] = True
-        vt = vrel[i] - vn * n
-        vtn = np.sqrt(vt @ vt)
-        cap = mu * fn
-        # stick: a tangential spring from where the contact first held (stretch[i], kept by
-        # the caller per point), with the normal's stiffness and damping. The stretch is shared
-        # by all contacts of a rigid body, so contacts far from their cap take up the load
-        # those at it cannot: a block sticks whenever the total friction mu N suffices.
-        u = stretch[i] - (stretch[i] @ n) * n + dt * vt
-        g = cs * u + cd * vt
-        gn = np.sqrt(g @ g)
-        visc = 0.0
-        if gn <= cap:
-            ft = -g
-            stick = cs
-            visc = cd
-        else:
-            # slip: Coulomb at the cone, opposing the spring and the slip (for steady sliding
-            # -mu f_n v_t/|v_t|, the regularized law above eps). Below eps the regularized
-            # law's viscous force mu f_n |v_t|/eps would let a loaded contact creep at that
-            # speed; the stick spring, saturated here, takes its place.
-            stick = 0.0
-            ft = -cap / gn * g
-            if vtn < eps:
-                visc = min(cap / eps, meff / dt) if dt > 0.0 else cap / eps
-            u = g * (cap / (gn * cs)) if cs > 0.0 else np.zeros(3)  # the spring at its limit
-        stretch[i] = u
+        # the stretch is shared by all contacts of a rigid body, so contacts far from their cap
+        # take up the load those at it cannot: a block sticks whenever mu N suffices
+        stick, visc = sticking_friction(n, vrel[i] - vn * n, fn, cs, cd, mu, eps, meff, dt,
+                                        stretch[i], ft)
         out_f[i] = fn * n + ft
         for a in range(3):
             for b in range(3):

@@ -18,6 +18,7 @@ midpoint value. The trapezoid average of old and new flow has |amplification|^2 
 wave energy and is stable for omega dt < 2, i.e. dt < l / sqrt(g d) (we keep 0.7 of it).
 """
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -27,6 +28,71 @@ SQRT2 = math.sqrt(2.0)
 VELOCITY_DEPTH_FLOOR = 1e-3
 #: outflow limit as a fraction of the column's volume: rounding can never make it negative
 _KEEP = 1.0 - 1e-12
+
+
+class Grid(NamedTuple):
+    """The basin: bed (nx, ny) heights (m), fluid (nx, ny) mask, pipe (4, nx, ny) which pipes
+    join two fluid columns, nearest (nx, ny) the flat index of the nearest fluid column (where
+    spray landing on a wall goes), area l^2 (m^2), x0, y0 the centre of column (0, 0) (m),
+    l the column width (m), w the pipe width (m)."""
+    bed: np.ndarray
+    fluid: np.ndarray
+    pipe: np.ndarray
+    nearest: np.ndarray
+    area: float
+    x0: float
+    y0: float
+    l: float
+    w: float
+
+
+class State(NamedTuple):
+    """The water's state: V (nx, ny) column volumes (m^3), Q (4, nx, ny) pipe flows (m^3/s),
+    ext (nx, ny) the external pressure head (m), rate (nx, ny) the surface's vertical speed
+    (m/s), px, pv (cap, 3) spray positions (m) and velocities (m/s), track (2,) the peak
+    particle count and the shallowest fluid column (m) seen."""
+    V: np.ndarray
+    Q: np.ndarray
+    ext: np.ndarray
+    rate: np.ndarray
+    px: np.ndarray
+    pv: np.ndarray
+    track: np.ndarray
+
+
+class Lids(NamedTuple):
+    """Where bodies cut the columns: cell (k,) a column's flat index, zlo, zhi (k, s^2) the
+    bottom and top (m) of the body's vertical chord at each sample point, scale (k,) the
+    volume scale, vz (k,) the body's vertical speed (m/s)."""
+    cell: np.ndarray
+    zlo: np.ndarray
+    zhi: np.ndarray
+    scale: np.ndarray
+    vz: np.ndarray
+
+
+class Settings(NamedTuple):
+    """g (m/s^2); kappa (-) the bodies' penalty head per metre; damping and body_damping (1/s)
+    pipe friction; cfl the substep as a fraction of the wave-speed limit; spray: on, threshold
+    (m/s), fraction (-), vp the particle volume (m^3), radius (m), drag (1/m)."""
+    g: float
+    kappa: float
+    damping: float
+    body_damping: float
+    cfl: float
+    spray: bool
+    threshold: float
+    fraction: float
+    vp: float
+    radius: float
+    drag: float
+
+
+class Scratch(NamedTuple):
+    """Per-step work arrays (nx, ny): the surface eta, the pressure head H, and out."""
+    eta: np.ndarray
+    H: np.ndarray
+    out: np.ndarray
 
 
 @njit(cache=True, inline="always")
@@ -93,7 +159,7 @@ def lid_level(eta, b, zlo, zhi, scale, kappa):
 
 
 @njit(cache=True)
-def heads(V, bed, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext, eta, H):
+def heads(grid, V, lids, n_lid, kappa, ext, eta, H):
     """Fill the surface eta, the external pressure head ext and the pressure head H (m).
 
     Bodies are given as *lids*: a column (flat index) with, at each of its sample points, the
@@ -102,6 +168,8 @@ def heads(V, bed, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext
     held down by the pressure the body exerts (``_content``). ext = H - eta is the body's
     pressure head; it is a function of the water's own state, so the coupling stores and
     returns energy like a spring instead of pumping it. (Two bodies over one column add.)"""
+    bed, area = grid.bed, grid.area
+    lid_cell, lid_zlo, lid_zhi, lid_scale = lids.cell, lids.zlo, lids.zhi, lids.scale
     nx, ny = V.shape
     inv = 1.0 / area
     for i in range(nx):
@@ -156,13 +224,16 @@ def column_velocity(Q, V, pipe, i, j, area, w):
 
 
 @njit(cache=True)
-def flow_step(V, Q, bed, pipe, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext,
-              l, g, w, damping, body_damping, dt, eta, H, out, rate):
+def flow_step(grid, state, lids, n_lid, settings, scratch, dt):
     """One step of the volume model: flows, outflow limiting, volumes. ``rate`` receives the
     surface's vertical speed dV/dt / l^2 (m/s). Every pipe moves the same volume out of one
     column and into the other, so the total is conserved to round-off."""
+    bed, pipe, area, l, w = grid.bed, grid.pipe, grid.area, grid.l, grid.w
+    V, Q, ext, rate = state.V, state.Q, state.ext, state.rate
+    g, damping, body_damping = settings.g, settings.damping, settings.body_damping
+    eta, H, out = scratch
     nx, ny = V.shape
-    heads(V, bed, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa, ext, eta, H)
+    heads(grid, V, lids, n_lid, settings.kappa, ext, eta, H)
     keep = 1.0 / (1.0 + damping * dt)  # implicit linear pipe friction (1/s)
     # under a body the penalty makes a stiff, light cavity whose trapped waves nothing would
     # damp; the body's wetted surface does (a viscous boundary layer): body_damping (1/s)
@@ -224,9 +295,11 @@ def flow_step(V, Q, bed, pipe, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_li
 
 
 @njit(cache=True)
-def _surface_velocity(px, py, x0, y0, l, fluid, Q, V, pipe, rate, area, w):
+def _surface_velocity(px, py, grid, state):
     """The surface's velocity (m/s) at (px, py): bilinear over the four nearest fluid
     columns of their flow velocity and the surface's vertical speed."""
+    x0, y0, l, fluid, pipe, area, w = grid.x0, grid.y0, grid.l, grid.fluid, grid.pipe, grid.area, grid.w
+    Q, V, rate = state.Q, state.V, state.rate
     nx, ny = V.shape
     fx = (px - x0) / l
     fy = (py - y0) / l
@@ -250,13 +323,16 @@ def _surface_velocity(px, py, x0, y0, l, fluid, Q, V, pipe, rate, area, w):
 
 
 @njit(cache=True)
-def emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold, fraction, vp, radius,
-               px, pv, count, dt):
+def emit_spray(grid, state, settings, H, count, dt):
     """Emit particles where the surface rises faster than ``threshold`` (m/s): the expected
     number from a column is fraction * l^2 (rate - threshold) dt / vp, rounded stochastically,
     placed uniformly over the column at its surface with the surface's interpolated velocity.
     Each particle's volume vp (m^3, radius m) leaves its column; columns shallower than four
     radii do not spray. Returns the new particle count."""
+    fluid, area, l, x0, y0 = grid.fluid, grid.area, grid.l, grid.x0, grid.y0
+    V, rate, px, pv = state.V, state.rate, state.px, state.pv
+    threshold, fraction, vp, radius = (settings.threshold, settings.fraction, settings.vp,
+                                       settings.radius)
     nx, ny = V.shape
     cap = px.shape[0]
     n = count
@@ -277,8 +353,7 @@ def emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold, fracti
                 px[n, 0] = x
                 px[n, 1] = y
                 px[n, 2] = H[i, j]
-                pv[n, 0], pv[n, 1], pv[n, 2] = _surface_velocity(x, y, x0, y0, l, fluid, Q, V,
-                                                                 pipe, rate, area, w)
+                pv[n, 0], pv[n, 1], pv[n, 2] = _surface_velocity(x, y, grid, state)
                 V[i, j] -= vp
                 n += 1
     return n
@@ -306,10 +381,13 @@ def _land(V, fluid, i, j, vp):
 
 
 @njit(cache=True)
-def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp, dt):
+def move_spray(grid, state, settings, H, count, dt):
     """Ballistic flight with quadratic air drag (a = g - drag |v| v, drag in 1/m). A particle
     that falls to the surface (or onto a wall) gives its volume back around the fluid column
     below it (the nearest fluid column, off the water). Returns the new count."""
+    fluid, bed, nearest, x0, y0, l = grid.fluid, grid.bed, grid.nearest, grid.x0, grid.y0, grid.l
+    V, px, pv = state.V, state.px, state.pv
+    g, drag, vp = settings.g, settings.drag, settings.vp
     nx, ny = V.shape
     n = count
     p = 0
@@ -336,15 +414,17 @@ def move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag, vp,
 
 
 @njit(cache=True)
-def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_zlo, lid_zhi, lid_scale,
-            lid_vz, n_lid, kappa, ext, x0, y0, l, g, w, damping, body_damping, h, dt_max, cfl,
-            eta, H, out, rate, spray_on, threshold, fraction, vp, radius, drag, px, pv, count,
-            seed, track):
+def advance(grid, state, lids, n_lid, settings, scratch, count, seed, h, dt_max):
     """Advance the water h seconds in equal substeps no longer than dt_max or the wave-speed
     limit cfl * l / sqrt(g d_max (1 + kappa if bodies touch it)), rechecked each coupling
-    step; the bodies' lids move on at their vertical speeds (a lid held still for the step and
-    jumping at its end would hit the water with pressure spikes of kappa v h). track = [peak
-    particle count, min depth (m)] is updated in place. Returns (particle count, substeps)."""
+    step; the bodies' first n_lid lids move on at their vertical speeds (a lid held still for
+    the step and jumping at its end would hit the water with pressure spikes of kappa v h).
+    count: airborne particles; seed: the spray's random seed for this call. state.track is
+    updated in place. Returns (particle count, substeps)."""
+    V, fluid, area, l = state.V, grid.fluid, grid.area, grid.l
+    g, kappa, cfl = settings.g, settings.kappa, settings.cfl
+    lid_zlo, lid_zhi, lid_vz = lids.zlo, lids.zhi, lids.vz
+    track = state.track
     dmax = max_depth(V, fluid, area)
     stiff = 1.0 + kappa if n_lid > 0 else 1.0
     lim = cfl * l / math.sqrt(g * dmax * stiff) if dmax > 0.0 else dt_max
@@ -353,13 +433,10 @@ def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_zlo, lid_zhi, l
     np.random.seed(seed)  # counter-based seeding: a rerun from a capture repeats the spray
     nx, ny = V.shape
     for _ in range(nsub):
-        flow_step(V, Q, bed, pipe, area, lid_cell, lid_zlo, lid_zhi, lid_scale, n_lid, kappa,
-                  ext, l, g, w, damping, body_damping, dt, eta, H, out, rate)
-        if spray_on:  # H is the substep's start: spray leaves and lands on it
-            count = emit_spray(V, Q, pipe, fluid, H, rate, area, l, w, x0, y0, threshold,
-                               fraction, vp, radius, px, pv, count, dt)
-            count = move_spray(px, pv, count, V, fluid, bed, H, nearest, x0, y0, l, g, drag,
-                               vp, dt)
+        flow_step(grid, state, lids, n_lid, settings, scratch, dt)
+        if settings.spray:  # H is the substep's start: spray leaves and lands on it
+            count = emit_spray(grid, state, settings, scratch.H, count, dt)
+            count = move_spray(grid, state, settings, scratch.H, count, dt)
         for k in range(n_lid):  # the bodies move on within the coupling step
             for s in range(lid_zlo.shape[1]):
                 lid_zlo[k, s] += lid_vz[k] * dt
@@ -374,9 +451,12 @@ def advance(V, Q, bed, pipe, fluid, nearest, area, lid_cell, lid_zlo, lid_zhi, l
 
 
 @njit(cache=True)
-def energy_momentum(V, Q, pipe, fluid, area, w, rho, px, pv, count, vp, out):
+def energy_momentum(grid, state, rho, count, vp, out):
     """Kinetic energy (J) and horizontal momentum (kg m/s) of the columns (from their flow
-    velocities) plus the vertical too for airborne particles: out = [E, px, py, pz]."""
+    velocities) plus the vertical too for airborne particles: out = [E, px, py, pz]; rho
+    (kg/m^3), count airborne particles of volume vp (m^3)."""
+    pipe, fluid, area, w = grid.pipe, grid.fluid, grid.area, grid.w
+    V, Q, pv = state.V, state.Q, state.pv
     nx, ny = V.shape
     e = 0.0
     mx = 0.0
@@ -417,13 +497,14 @@ def _chord(c, A, x, y):
 
 
 @njit(cache=True)
-def add_ellipsoid(c, vz, A, M, full_volume, fluid, x0, y0, l, ns, lid_cell, lid_zlo, lid_zhi,
-                  lid_scale, lid_vz, n):
+def add_ellipsoid(c, vz, A, M, full_volume, grid, ns, lids, n):
     """Append the lids of the ellipsoid {p : (p - c)^T A (p - c) <= 1} (M = A^-1: its
     horizontal half extents are sqrt(M00), sqrt(M11)) moving up at vz (m/s) from index n: one
     per fluid column its shadow touches, sampled at ns x ns points. The scale full_volume /
     (sampled volume) gives the sampled body its exact volume. Returns the new count, or -1
     if the buffers are too small."""
+    fluid, x0, y0, l = grid.fluid, grid.x0, grid.y0, grid.l
+    lid_cell, lid_zlo, lid_zhi, lid_scale, lid_vz = lids
     nx, ny = fluid.shape
     ex = math.sqrt(M[0, 0])
     ey = math.sqrt(M[1, 1])
@@ -461,12 +542,14 @@ def add_ellipsoid(c, vz, A, M, full_volume, fluid, x0, y0, l, ns, lid_cell, lid_
 
 
 @njit(cache=True)
-def lid_load(V, Q, pipe, bed, area, rate, lid_cell, lid_zlo, lid_zhi, lid_scale, start, stop,
-             kappa, x0, y0, l, w, out):
+def lid_load(grid, state, lids, start, stop, kappa, out):
     """What the water does to the body whose lids are [start, stop): out = [displaced volume
     (m^3: the sum of pressure head times column area, so rho g out[0] is the force), centre of
     buoyancy (3) m, water velocity (3) m/s]; the velocity is load-weighted, horizontal from the
     flows, vertical the surface's scaled by the height above the bed."""
+    pipe, bed, area, x0, y0, l, w = grid.pipe, grid.bed, grid.area, grid.x0, grid.y0, grid.l, grid.w
+    V, Q, rate = state.V, state.Q, state.rate
+    lid_cell, lid_zlo, lid_zhi, lid_scale = lids.cell, lids.zlo, lids.zhi, lids.scale
     nx, ny = V.shape
     ns2 = lid_zlo.shape[1]
     ns = int(round(math.sqrt(ns2)))

@@ -59,6 +59,15 @@ def _table(head, rows, classes=None) -> str:
     return "".join(out)
 
 
+def _figure(value) -> str:
+    """A scene's key figure as shown: a number to 3 places, a vector to 2."""
+    if value is None:
+        return "-"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(f"{v:.2f}" for v in value)
+    return f"{value:.3f}"
+
+
 def _mmm(d, nd) -> str:
     return " / ".join(_f(d[k], nd) for k in ("min", "max", "mean"))
 
@@ -190,21 +199,21 @@ def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
     out = Path(out_dir)
     written, plots = [], []
     stats = {s["name"]: s for s in summary["interactions"]}
-    for it in result.scene.interactions:
-        log, s = result.logs[it.name], stats.get(it.name)
+    for it in result.interactions:
+        name, primary = it["name"], it["primary"]
+        log, s = result.logs[name], stats.get(name)
         if s is None or not len(log.t):
             continue
         if not log.active.any() and (log.standin is None or not log.standin.active.any()):
-            plots.append(f"<h3>{_e(it.name)}</h3><p>No contact during the run: no force on "
-                         f"{_e(it.primary.name)}.</p>")
+            plots.append(f"<h3>{_e(name)}</h3><p>No contact during the run: no force on "
+                         f"{_e(primary)}.</p>")
             continue
-        p = force_plot(log, s, out / f"plot_force_{_slug(it.name)}.png", result.scene.duration)
+        p = force_plot(log, s, out / f"plot_force_{_slug(name)}.png", result.duration)
         written.append(p)
-        plots.append(f'<h3>{_e(it.name)}</h3><img class="plot" src="{_e(_rel(p, out))}" '
-                     f'alt="force of {_e(it.name)} on {_e(it.primary.name)} over time">'
+        plots.append(f'<h3>{_e(name)}</h3><img class="plot" src="{_e(_rel(p, out))}" '
+                     f'alt="force of {_e(name)} on {_e(primary)} over time">'
                      + _windows_table(s))
     rows, classes = table_i_rows(summary["interactions"], _masses(summary))
-    sc = result.scene
     sections = [
         ("video", "Preview", _video(video, out, _caption(video_info))),
         ("interactions", "Interaction forces on the primary", "".join(plots)
@@ -217,9 +226,10 @@ def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
         ("diagnostics", "Diagnostics", _diagnostics(summary)),
         ("files", "Files", _files(files, out)),
     ]
-    sub = (f"coupling <b>{_e(sc.coupling)}</b>; {sc.duration:g} s simulated at "
-           f"{sc.fps:g} output frames/s; metres, seconds, +z up")
-    written.append(_write(out / "report.html", _page(f"Interplay: {sc.name}", sub, sections)))
+    sub = (f"coupling <b>{_e(result.coupling)}</b>; {result.duration:g} s simulated at "
+           f"{result.fps:g} output frames/s; metres, seconds, +z up")
+    written.append(_write(out / "report.html", _page(f"Interplay: {result.scene}", sub,
+                                                      sections)))
     return written
 
 
@@ -252,9 +262,10 @@ def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=No
                      f'alt="{_e(first.primary)} height over time">')
     modes = list(rows)
     line = lambda label, fn: [_e(label), *(fn(rows[m]) for m in modes)]  # noqa: E731
+    labels = list(dict.fromkeys(k for r in rows.values() for k in r.get("figures", {})))
     table = _table(["", *modes], [
-        line("exit speed (m/s)", lambda r: _f(r.get("exit_speed"), 3)),
-        line("free-flight speed then (m/s)", lambda r: _f(r.get("free_flight_exit_speed"), 3)),
+        *(line(label, lambda r, k=label: _figure(r.get("figures", {}).get(k)))
+          for label in labels),
         line("contact (s)", lambda r: "{:.3f}-{:.3f}".format(*r["contact_s"])
              if r.get("contact_s") else "none"),
         line("force min / max / mean (N)", lambda r: _mmm(r["force_N"], 1)),

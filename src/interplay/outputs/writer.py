@@ -178,8 +178,8 @@ def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
         reports = {m: d / "report.html" for m, d in mode_dirs.items()
                    if (d / "report.html").exists()}
         files = {"compare.json": out / "compare.json"} if (out / "compare.json").exists() else {}
-        it = next(iter(results.values())).scene.main_interaction
-        pair = (it.primary.name, it.secondary.name) if it is not None else None
+        it = next(iter(results.values())).main_interaction
+        pair = (it["primary"], it["secondary"]) if it is not None else None
         written = write_compare_report(runs, out, rows, advice, video, reports, files, pair,
                                        st)
         paths += written

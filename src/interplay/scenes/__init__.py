@@ -1,24 +1,22 @@
-"""The gallery: one module per scene, each with ``build(**params) -> Scene``."""
+"""The gallery: one module per scene, each registering its ``SceneSpec`` as ``SPEC``."""
 from __future__ import annotations
 
 import importlib
 
 from ..errors import SceneError
 
-#: scene name -> (module, one-line description)
-REGISTRY = {
-    "basketball": ("basketball", "a basketball falls through a spring-mass net (two-way, "
-                                 "one-way or hybrid)"),
-    "bungee": ("bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)"),
-    "flags": ("flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)"),
-    "leaves": ("leaves", "a passing bicyclist's wake stirs up leaves that settle again (one-way)"),
-    "pond": ("pond", "balls of different densities float, bob and sink in a pond (two-way)"),
-    "puddle": ("puddle", "a keyframed foot steps in a shallow puddle and splashes it (one-way)"),
-}
+#: the scene modules, loaded on demand (a scene's module imports its systems)
+MODULES = ("basketball", "bungee", "flags", "leaves", "pond", "puddle")
 
 
-def load(name: str):
-    """The scene module for ``name``; SceneError listing the known scenes otherwise."""
-    if name not in REGISTRY:
-        raise SceneError(f"unknown scene {name!r}; known scenes: {', '.join(sorted(REGISTRY))}")
-    return importlib.import_module(f"{__name__}.{REGISTRY[name][0]}")
+def spec(name: str):
+    """The SceneSpec of the scene called ``name``; SceneError listing the known scenes."""
+    for module in MODULES:
+        if module.replace("_", "-") == name:
+            return importlib.import_module(f"{__name__}.{module}").SPEC
+    raise SceneError(f"unknown scene {name!r}; known scenes: {', '.join(sorted(MODULES))}")
+
+
+def all_specs() -> list:
+    """Every registered scene's SceneSpec, by name."""
+    return [spec(name) for name in sorted(MODULES)]

@@ -2,15 +2,19 @@
 net hung from a fixed rim, coupled two-way, one-way or hybrid (a damping field stand-in)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
+
+import numpy as np
 
 from ..geometry.net import NetParams, basketball_net
 from ..interactions.contact import ContactParams, SphereCordContact, SpherePlaneContact
 from ..interactions.standins import DampingField, DampingFieldParams
 from ..errors import ParameterError
 from ..scene import Scene
+from ..systems.base import GRAVITY
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
+from .contract import SceneSpec
 
 
 @dataclass(frozen=True)
@@ -42,8 +46,6 @@ class BasketballParams:
     mesh_subdivisions: int = 3
 
 
-PARAMS = BasketballParams
-STANDIN = "field"  # the params field holding the hybrid stand-in's coefficients
 FIT_TIME = 0.6  # s: the ball has left the net and not yet reached the floor
 CHECKPOINTS = [0.2, 0.3, 0.4, 0.5, 0.6]  # s, the ball's state is reported at these times
 
@@ -60,7 +62,8 @@ def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
     b = params.ball
     scene = Scene("basketball", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
     ball = scene.add(Sphere("ball", SphereParams(b.radius, b.mass, b.shell, b.dt),
-                            position=b.position, velocity=b.velocity, angular_velocity=b.spin))
+                            subdivisions=params.mesh_subdivisions, position=b.position,
+                            velocity=b.velocity, angular_velocity=b.spin))
     net = scene.add(basketball_net(net_p))
     if params.settle:
         net.settle()
@@ -76,8 +79,7 @@ def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
         mp = MeshContactParams(thickness=contact.thickness, friction=contact.friction,
                                eps=contact.eps, stiffness=contact.stiffness,
                                damping=contact.damping, constraint=contact.constraint)
-        scene.connect(MeshContact("ball-net", ball, net, mp, mode=coupling, standin=field_,
-                                  surfaces={"ball": ball.surface(params.mesh_subdivisions)}))
+        scene.connect(MeshContact("ball-net", ball, net, mp, mode=coupling, standin=field_))
     elif params.contact_model == "cords":
         scene.connect(SphereCordContact("ball-net", ball, net, contact, mode=coupling,
                                         standin=field_))
@@ -89,3 +91,26 @@ def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
     scene.checkpoints = {"ball": CHECKPOINTS}
     scene.meta = {"rim_center": (0.0, 0.0, net_p.rim_height), "rim_radius": net_p.rim_radius}
     return scene
+
+
+def exit_figures(result) -> dict:
+    """The ball as it leaves the net (the end of the first contact period): its velocity and
+    speed, and the speed free flight would have given it then (v(t) = v(0) + g t)."""
+    it = result.main_interaction
+    stats = next(s for s in result.interaction_stats() if s["name"] == it["name"])
+    if not stats["contact_s"] or result.primary not in result.tracks:
+        return {}
+    t_exit = stats["contact_s"][1]
+    _, v = result.state_at(result.primary, t_exit)
+    _, v0 = result.state_at(result.primary, 0.0)
+    free = v0[:3] + GRAVITY * t_exit
+    return {"exit time (s)": t_exit, "exit velocity (m/s)": v[:3].tolist(),
+            "exit speed (m/s)": float(np.linalg.norm(v[:3])),
+            "free-flight speed then (m/s)": float(np.linalg.norm(free))}
+
+
+SPEC = SceneSpec(
+    "basketball", "a basketball falls through a spring-mass net (two-way, one-way or hybrid)",
+    build, BasketballParams, couplings=("two-way", "one-way", "hybrid"), duration=1.5, fps=60.0,
+    integrators=("explicit", "implicit", "localglobal"), standin="field", fit_time=FIT_TIME,
+    figures=exit_figures)

@@ -24,6 +24,7 @@ from ..scene import Scene
 from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
+from .contract import SceneSpec
 
 BRIDGE = 40.0  # m, the platform's top
 EDGE = 0.0  # m, x of the platform's front edge (the jumper faces +x)
@@ -89,9 +90,6 @@ class BungeeParams:
     air_density: float = 1.2  # kg/m^3
 
 
-PARAMS = BungeeParams
-
-
 def controller(p: JumperParams) -> Controller:
     """stand -> crouch -> tip -> leap -> tuck (the feet clear the edge) -> layout (the rest
     of the flight, the bounces and the hang)."""
@@ -149,7 +147,7 @@ def build(coupling: str = "two-way", duration: float = 8.0, fps: float = 30.0,
     scene.primary = fig
     if c.enabled:
         feet = ("l_foot", "r_foot")
-        ankles = fig.data.xpos[[fig.seg_body[SEGMENTS.index(f)] for f in feet]]
+        ankles = fig.contact_view().poses()[0][[SEGMENTS.index(f) for f in feet]]
         net = scene.add(cord(c, [EDGE + c.reach, 0.0, BRIDGE + ANCHOR_HEIGHT], ankles,
                              integrator or "implicit", dt))
         n = c.points
@@ -211,6 +209,12 @@ def tune_leap(evaluations: int = 150, seed: int = 0, start: JumperParams = Jumpe
     res = anneal(lambda d: leap_loss(replace(start, **d)),
                  {k: getattr(start, k) for k in TUNED}, BOUNDS, evaluations, seed)
     return replace(start, **res.best), res
+
+
+SPEC = SceneSpec(
+    "bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)", build,
+    BungeeParams, couplings=("two-way", "one-way"), duration=8.0, fps=30.0,
+    integrators=("explicit", "implicit", "localglobal"))
 
 
 if __name__ == "__main__":

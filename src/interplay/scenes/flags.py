@@ -7,13 +7,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import SceneError
 from ..geometry import shapes
 from ..interactions.aero import AeroParams, Aerodynamics
 from ..scene import Scene
-from ..systems.path import Path, PathFollower
+from ..systems.colliders import StaticMesh
 from ..systems.springmass import SpringNetwork
 from ..systems.wind import FlowPrimitive, WindField
+from .contract import SceneSpec
 
 
 @dataclass(frozen=True)
@@ -68,9 +68,6 @@ class FlagsParams:
                                     shear=150.0, bend=3.0)
 
 
-PARAMS = FlagsParams
-
-
 def wind_field(w: GustyWind) -> WindField:
     h = math.radians(w.heading)
     along, across = (math.cos(h), math.sin(h), 0.0), (-math.sin(h), math.cos(h), 0.0)
@@ -96,11 +93,9 @@ def flag(name: str, p: FlagParams) -> SpringNetwork:
 def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
           integrator: str | None = None, dt: float | None = None,
           params: FlagsParams = FlagsParams()) -> Scene:
-    """The scene; integrator and dt (s) override every flag's. The wind ignores forces, so
-    one-way and two-way give the same motion; there is no stand-in for hybrid."""
-    if coupling == "hybrid":
-        raise SceneError("flags: the wind has no stand-in (it does not feel the flags at all); "
-                         "use one-way")
+    """The scene; integrator and dt (s) override every flag's. The wind ignores forces: the
+    coupling is one-way (the air does not feel the cloth). The poles are set pieces (static
+    meshes: drawn, costing no pass)."""
     scene = Scene("flags", duration=duration, fps=fps)
     wind = scene.add(wind_field(params.wind))
     for name in ("cotton", "nylon", "canvas"):
@@ -111,9 +106,13 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
             p = replace(p, dt=dt)
         cloth = scene.add(flag(name, p))
         pv, pt = shapes.pole(p.pole_height + 0.1)
-        here = [np.asarray(p.pole, float)] * 2
-        scene.add(PathFollower(f"{name}-pole", Path([0.0, 1.0], here), pv, pt, mass=5.0,
-                               dt=1.0 / fps))  # a frame per output frame, like the flags
+        scene.add(StaticMesh(f"{name}-pole", pv + np.asarray(p.pole, float), pt))
         scene.connect(Aerodynamics(f"wind-{name}", wind, cloth, params.aero, mode="one-way"))
     scene.primary = wind
     return scene
+
+
+SPEC = SceneSpec(
+    "flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)", build,
+    FlagsParams, couplings=("one-way",), duration=4.0, fps=60.0,
+    integrators=("explicit", "implicit", "localglobal"))

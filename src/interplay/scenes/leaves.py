@@ -8,7 +8,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import SceneError
 from ..geometry import shapes
 from ..interactions.aero import AeroParams, Aerodynamics
 from ..interactions.ground import GroundContact, GroundParams
@@ -17,6 +16,7 @@ from ..systems.path import Path, PathFollower
 from ..systems.springmass import SpringNetwork
 from ..systems.static import StaticPlane
 from ..systems.wind import FlowPrimitive, WindField
+from .contract import SceneSpec
 
 
 @dataclass(frozen=True)
@@ -75,9 +75,6 @@ class LeavesParams:
     ground: GroundParams = GroundParams(stiffness=1.0e6, damping=1000.0)
 
 
-PARAMS = LeavesParams
-
-
 def scatter(p: LeafParams):
     """(vertices, triangles, vein vertices) of p.count leaves lying flat on the ground."""
     rng = np.random.default_rng(p.seed)
@@ -115,11 +112,8 @@ def wake(r: RiderParams, path: Path) -> WindField:
 def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
           integrator: str | None = None, dt: float | None = None,
           params: LeavesParams = LeavesParams()) -> Scene:
-    """The scene; integrator and dt (s) override the leaves'. The wake ignores forces, so
-    one-way and two-way give the same motion; there is no stand-in for hybrid."""
-    if coupling == "hybrid":
-        raise SceneError("leaves: the wake has no stand-in (the air does not feel the leaves "
-                         "at all); use one-way")
+    """The scene; integrator and dt (s) override the leaves'. The wake ignores forces: the
+    coupling is one-way (the air does not feel the leaves)."""
     lp = params.leaves
     if integrator is not None:
         lp = replace(lp, integrator=integrator)
@@ -143,4 +137,11 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
     scene.connect(Aerodynamics("wake-leaves", air, leaves, params.aero, mode="one-way"))
     scene.connect(GroundContact("ground-leaves", ground, leaves, params.ground, mode="one-way"))
     scene.primary = rider
+    scene.main = "wake-leaves"
     return scene
+
+
+SPEC = SceneSpec(
+    "leaves", "a passing bicyclist's wake stirs up leaves that settle again (one-way)", build,
+    LeavesParams, couplings=("one-way",), duration=4.0, fps=60.0,
+    integrators=("explicit", "implicit", "localglobal"))

@@ -17,6 +17,7 @@ from ..scene import Scene
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
 from ..systems.water import Water, WaterParams
+from .contract import SceneSpec
 
 
 @dataclass(frozen=True)
@@ -49,17 +50,10 @@ class PondParams:
     coupling_dt: float = 2e-3  # s
 
 
-PARAMS = PondParams
-STANDIN = "field"
-
-
 def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
           integrator: str | None = None, dt: float | None = None,
           params: PondParams = PondParams()) -> Scene:
     """The scene. dt overrides the water's largest step (s); the water has one integrator."""
-    if integrator is not None:
-        raise ParameterError(f"pond: --integrator {integrator} does not apply: the water has "
-                             "one integrator (virtual pipes); leave it out")
     b, wp = params.balls, params.water
     n = int(b.count)
     for key in ("radius", "density", "x", "y", "height"):
@@ -93,3 +87,8 @@ def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
     scene.checkpoints = {bl.name: [1.0, 2.0, 3.0] for bl in balls}
     scene.meta = {"still_level": level, "densities": list(b.density[:n])}
     return scene
+
+
+SPEC = SceneSpec(
+    "pond", "balls of different densities float, bob and sink in a pond (two-way)", build,
+    PondParams, couplings=("two-way", "one-way", "hybrid"), duration=4.0, fps=60.0)

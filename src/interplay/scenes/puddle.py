@@ -14,7 +14,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import ParameterError
 from ..geometry.basin import BasinParams, basin
 from ..interactions.buoyancy import BodyInWater, BuoyancyParams
 from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
@@ -22,6 +21,7 @@ from ..scene import Scene
 from ..systems.kinematic import KeyframedBody, KeyframedBodyParams
 from ..systems.mocap import MocapFigure, clip_path
 from ..systems.water import SprayParams, Water, WaterParams
+from .contract import SceneSpec
 
 
 @dataclass(frozen=True)
@@ -56,8 +56,6 @@ class PuddleParams:
     clip: str = "cmu_02_03_run.bvh"  # the runner; "" (or no data folder): the keyframed foot
 
 
-PARAMS = PuddleParams
-STANDIN = "field"
 STANCE = (0.8, 1.1)  # s: the right foot's second stance in the jog clip
 
 
@@ -89,9 +87,6 @@ def build(coupling: str = "one-way", duration: float = 1.5, fps: float = 60.0,
           params: PuddleParams = PuddleParams()) -> Scene:
     """The scene. dt overrides the water's largest step (s). Every coupling mode gives the
     same foot (nothing moves an animation); one-way is the honest one."""
-    if integrator is not None:
-        raise ParameterError(f"puddle: --integrator {integrator} does not apply: the water "
-                             "has one integrator (virtual pipes); leave it out")
     wp = params.water if dt is None else replace(params.water, dt=dt)
     geo = basin(params.basin)
     scene = Scene("puddle", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
@@ -110,3 +105,8 @@ def build(coupling: str = "one-way", duration: float = 1.5, fps: float = 60.0,
     scene.checkpoints = {"foot": [0.2, 0.4]}
     scene.meta = {"still_level": params.basin.depth}
     return scene
+
+
+SPEC = SceneSpec(
+    "puddle", "a motion-captured runner's foot steps in a shallow puddle and splashes it "
+    "(one-way)", build, PuddleParams, couplings=("one-way",), duration=1.5, fps=60.0)

@@ -2,19 +2,22 @@
 
 Like ``StaticPlane`` they are infinitely massive, never move and record nothing. Each answers
 ``distance(points) -> (s, n)``: the signed distance (m, negative inside) of every point and the
-outward normal there, which is all ``MeshContact`` needs from a static shape. ``surface()``
-gives triangles for drawing and for bodies that collide through their own points.
+outward normal there, which is all a contact needs from a static shape (its ShapeView).
+``surface()`` gives the triangles drawn and exported; a static mesh is also how a scene's set
+pieces (a pole, a rim, a deck) are drawn, collidable where the scene connects them.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import ParameterError, require_positive
-from ..geometry.aabb_tree import BVH, check_points
+from ..geometry.aabb_tree import AABBTree, check_points
 from ..geometry.sphere import icosphere
 from ..kernels.trimesh_contact import (box_distance, capsule_distance,
                                        signed_triangle_distance)
+from .shape import Shape
 from .static import Stateless
+from .views import ShapeView
 
 
 def box_surface(half):
@@ -27,7 +30,18 @@ def box_surface(half):
 
 
 class StaticShape(Stateless):
-    """Base of immovable colliders: mass inf, no state, never stepped."""
+    """Base of immovable colliders: mass inf, no state, never stepped. color: linear RGB
+    (0..1) as drawn, None for the outputs' default."""
+
+    color = None
+
+    def contact_view(self):
+        return ShapeView(self, self.distance)
+
+    def shapes(self):
+        v, t = self.surface()
+        return [Shape(self.name, "static", color=self.color, verts=np.asarray(v, float),
+                      tris=np.asarray(t), palette="static")]
 
     def distance(self, points):
         """Signed distance (n,) m and outward unit normals (n,3) of points (n,3)."""
@@ -101,7 +115,7 @@ class StaticMesh(StaticShape):
     def __init__(self, name, vertices, triangles, depth=0.05):
         super().__init__(name)
         self.depth = require_positive(name, "depth", depth, "m")
-        self.tree = BVH(vertices, triangles, owner=name)
+        self.tree = AABBTree(vertices, triangles, owner=name)
         self.vertices, self.triangles = self.tree.x, self.tree.elements
 
     def distance(self, points, reach=None):

@@ -20,9 +20,12 @@ from ..control.fsm import Controller, StateMachine
 from ..control.gravity import GravityCompensation
 from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
-from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, joint_names, segment_mesh
-from .base import System
+from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, joint_names,
+                                      segment_mesh, segment_primitive)
+from .base import System, substeps
 from .figure_model import AirDrag, EnvironmentParams, build_model, geom_extents, joint_group
+from .shape import Shape
+from .views import BodiesView, RigidParts
 
 LEG_GROUPS = ("hip", "knee", "ankle", "toe")
 FEET = ("l_foot", "l_toes", "r_foot", "r_toes")
@@ -55,12 +58,17 @@ class FigureParams:
     gravity_compensation: bool = True
 
 
-class Figure(System):
+class Figure(System, RigidParts):
     """An articulated human figure. Generalized state: (qpos, d qpos/dt) — for the free root
     the quaternion's time derivative, not MuJoCo's body-frame angular velocity, so tracks can
-    Hermite-interpolate a consistent pair. Segment order is anthropometry.SEGMENTS."""
+    Hermite-interpolate a consistent pair. Segment order is anthropometry.SEGMENTS; its contact
+    view has one part per segment.
 
-    kind = "figure"
+    The servo gains in MuJoCo's model (actuator bias parameters) and its time step are derived
+    from the controller state (omega, zeta, the support flag: all in ``capture()``) and the
+    substep, rewritten from them on restore and at every advance: the model holds no state of
+    its own."""
+
     integrator = "MuJoCo implicitfast, PD servo actuators"
 
     def __init__(self, name: str, params: FigureParams = FigureParams(),
@@ -147,6 +155,11 @@ class Figure(System):
         self._gx, self._gv = np.zeros(nq), np.zeros(nq)
         self._qdot, self._w = np.zeros(4), np.zeros(4)
         self._extent, self._round = geom_extents(m, self.seg_geom)
+        self._twist = np.zeros(6)
+        self.color = None
+        self._view = BodiesView(self, SEGMENTS, self.segment_meshes(),
+                                [segment_primitive(s.shape) for s in self.plan],
+                                m.body_mass[self.seg_body], movable=True)
 
     # --- servos and control ------------------------------------------------------------------
     def apply_gains(self):
@@ -318,8 +331,8 @@ class Figure(System):
         self._run(1, h)
         self._sync()
 
-    def advance(self, h):
-        n = max(1, math.ceil(h / self.dt - 1e-9))
+    def advance(self, h, dt=None):
+        n = substeps(h, self.dt if dt is None else dt)
         self._run(n, h / n)
         self._sync()
         self.time += h
@@ -435,6 +448,44 @@ class Figure(System):
                 "segment_orientations": d.xquat[self.seg_body].copy(),
                 "segment_wrenches": d.xfrc_applied[self.seg_body].copy(),
                 "com": d.subtree_com[self.root].copy()}
+
+    # --- the contact view: one rigid part per segment ---------------------------------------
+    def contact_view(self):
+        return self._view
+
+    def part_poses(self):
+        d = self.data
+        return d.xpos[self.seg_body], d.xmat[self.seg_body].reshape(-1, 3, 3)
+
+    def part_centres(self):
+        return self.data.xipos[self.seg_body]
+
+    def part_velocities(self, parts=None):
+        """MuJoCo's velocities of the segments' centres of mass, world frame (one call per
+        segment asked for)."""
+        bodies = self.seg_body if parts is None else self.seg_body[np.asarray(parts)]
+        lin, ang = np.empty((len(bodies), 3)), np.empty((len(bodies), 3))
+        for k, b in enumerate(bodies):
+            self._mj.mj_objectVelocity(self.model, self.data, self._mj.mjtObj.mjOBJ_BODY,
+                                       int(b), self._twist, 0)
+            ang[k], lin[k] = self._twist[:3], self._twist[3:]
+        return lin, ang
+
+    def part_inverse_inertias(self):
+        """Zero: a contact sees a segment's own mass only; its joints make the real effective
+        mass larger, so the contact is a little softer than it could be, never less stable."""
+        return np.zeros((len(self.seg_body), 3, 3))
+
+    def centre_of_mass(self):
+        return self.com()
+
+    def add_part_wrench(self, part, force, torque=None, point=None, dfdx=None, dfdv=None):
+        self.add_wrench(force, torque, point, body=int(part))
+
+    def shapes(self):
+        return [Shape(self.name, "parts", color=self.color,
+                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
+                             for v, t in self.segment_meshes()])]
 
     # --- geometry ----------------------------------------------------------------------------
     def segment_meshes(self) -> list:

@@ -8,7 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_positive
-from .base import System
+from ..geometry.primitive import Primitive
+from ..geometry.sphere import icosphere
+from .base import Role, System
+from .shape import Shape
+from .views import BodiesView, RigidParts
 
 
 @dataclass(frozen=True)
@@ -25,16 +29,16 @@ class KeyframedBodyParams:
     dt: float = 0.01  # s
 
 
-class KeyframedBody(System):
+class KeyframedBody(System, RigidParts):
     """An ellipsoid whose centre follows keyframes by monotone cubic Hermite interpolation
     (PCHIP: positions and velocities continuous, no overshoot between keys, so a foot planted
     by two equal keys stays still). Before the first key and after the last it holds still.
 
     State: position x (m) and velocity v (m/s); orientation q (w, x, y, z) is fixed. Forces
-    are accepted and ignored (``add_wrench``)."""
+    are ignored. Its contact view: one prescribed part, an ellipsoid (primitive) drawn and
+    collided as an icosphere scaled to its semi-axes."""
 
-    kind = "kinematic"
-    accepts_forces = False
+    role = Role.PRESCRIBED
     integrator = "keyframes (monotone cubic Hermite)"
 
     def __init__(self, name, params: KeyframedBodyParams = KeyframedBodyParams()):
@@ -66,6 +70,12 @@ class KeyframedBody(System):
         self.x = np.zeros(3)
         self.v = np.zeros(3)
         self._place(0.0)
+        self.color = None
+        v, t = icosphere(3)
+        self._mesh = (v * self.semi_axes, t)
+        self._view = BodiesView(self, [name], [self._mesh],
+                                [Primitive("ellipsoid", axes=tuple(self.semi_axes))], [np.inf],
+                                movable=False)
 
     def _place(self, t):
         tc = min(max(t, self._t0), self._t1)
@@ -76,20 +86,33 @@ class KeyframedBody(System):
     def mass(self):
         return self._mass
 
-    def add_wrench(self, force, torque=None, point=None):
-        """Ignored: the animation decides the motion."""
-
     def step(self, h):
         """Move along the keyframes by h seconds (a kinematic body has no substeps)."""
         self.time += h
         self._place(self.time)
 
-    def advance(self, h):
+    def advance(self, h, dt=None):
         self.step(h)
 
-    def ellipsoid(self):
-        """(semi-axes (3,) m, rotation (3, 3) body to world) of the body's shape."""
-        return self.semi_axes, self.rotation
+    def contact_view(self):
+        return self._view
+
+    def part_poses(self):
+        return self.x[None], self.rotation[None]
+
+    def part_centres(self):
+        return self.x[None]
+
+    def part_velocities(self, parts=None):
+        k = 1 if parts is None else len(parts)
+        return np.repeat(self.v[None], k, axis=0), np.zeros((k, 3))
+
+    def centre_of_mass(self):
+        return self.x
+
+    def shapes(self):
+        v, t = self._mesh
+        return [Shape(self.name, "body", color=self.color, verts=v, tris=t, palette="rigid")]
 
     def lowest_z(self):
         """Height (m) of the body's lowest point."""

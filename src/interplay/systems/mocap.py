@@ -1,5 +1,5 @@
 """Motion-capture figures: a BVH clip retargeted onto the figure's 17 segments and played as a
-kinematic primary (SPEC 2.3): it follows the clip and ignores forces (kind "mocap").
+kinematic primary (SPEC 2.3): it follows the clip and ignores forces (Role.PRESCRIBED).
 
 Retargeting: units and up axis are detected from the skeleton; the clip's joints are matched
 to segments by name (CMU cgspeed and bvh11 schemes, and the same names behind a "prefix:");
@@ -16,9 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, segment_mesh
+from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, segment_mesh,
+                                      segment_primitive)
 from ..io.motion_file import BVHError, Motion, read_bvh
-from .base import System
+from ..kernels.rigid import quat_mul
+from .base import Role, System
+from .shape import Shape
+from .views import BodiesView, RigidParts
 
 # segment -> (candidate joint names, candidate names of the joint ending its bone)
 NAMES = {
@@ -69,13 +73,12 @@ def _quats(R) -> np.ndarray:
     return np.roll(q, 1, axis=-1).reshape(R.shape[:-2] + (4,))
 
 
-class MocapFigure(System):
+class MocapFigure(System, RigidParts):
     """A figure that plays a retargeted BVH clip. mass (kg) is what the analysis divides
     interaction forces by; units: one of UNITS or None to detect; skip_tpose: drop a first
     frame whose rotations are all zero (the T-pose the cgspeed conversion adds)."""
 
-    kind = "mocap"
-    accepts_forces = False
+    role = Role.PRESCRIBED
     integrator = "retargeted BVH clip, cubic spline playback"
 
     def __init__(self, name: str, path, mass: float = 75.0, units: str | None = None,
@@ -145,6 +148,11 @@ class MocapFigure(System):
         self.motion = motion
         self._x = self._spline(0.0)
         self._v = self._d_spline(0.0)
+        self.color = None
+        prims = [segment_primitive(sg.shape) for sg in self.plan]
+        self._middle = np.array([pr.middle for pr in prims])  # m, segment frame
+        self._view = BodiesView(self, SEGMENTS, self.segment_meshes(), prims,
+                                np.full(17, np.inf), movable=False)
 
     @staticmethod
     def _rest_positions(motion: Motion) -> np.ndarray:
@@ -188,7 +196,7 @@ class MocapFigure(System):
     def step(self, h):
         self._sample(self.time + h)
 
-    def advance(self, h):
+    def advance(self, h, dt=None):
         self.time += h
         self._sample(self.time)
 
@@ -225,6 +233,43 @@ class MocapFigure(System):
 
     def segment_meshes(self) -> list:
         return [segment_mesh(s.shape) for s in self.plan]
+
+    # --- the contact view: 17 prescribed parts ------------------------------------------------
+    def contact_view(self):
+        return self._view
+
+    def part_poses(self):
+        from scipy.spatial.transform import Rotation
+        q = self.segment_orientations()
+        R = Rotation.from_quat(np.roll(q, -1, axis=1)).as_matrix()
+        return self.segment_positions(), R
+
+    def part_centres(self):
+        """Each segment's middle (its shape's centre): the clip carries no masses."""
+        pos, R = self.part_poses()
+        return pos + np.einsum("kij,kj->ki", R, self._middle)
+
+    def part_velocities(self, parts=None):
+        """The clip's velocities: w = 2 qdot q* (world frame) and the middle's velocity."""
+        if parts is not None:
+            lin, ang = self.part_velocities()
+            return lin[parts], ang[parts]
+        q = self.segment_orientations()
+        qd = self._v[51:].reshape(17, 4)
+        conj = q * np.array([1.0, -1.0, -1.0, -1.0])
+        ang = np.array([2.0 * quat_mul(qd[k], conj[k])[1:] for k in range(17)])
+        pos, _ = self.part_poses()
+        lin = self._v[:51].reshape(17, 3) + np.cross(ang, self.part_centres() - pos)
+        return lin, ang
+
+    def centre_of_mass(self):
+        m = np.array([sg.mass for sg in self.plan])
+        return (m[:, None] * self.part_centres()).sum(axis=0) / m.sum()
+
+    def shapes(self):
+        return [Shape(self.name, "parts", color=self.color,
+                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
+                             for v, t in self.segment_meshes()])]
 
 
 def clip_path(name: str) -> Path:

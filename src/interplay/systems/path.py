@@ -7,7 +7,9 @@ import math
 import numpy as np
 
 from ..errors import ParameterError, require_positive
-from .base import System
+from .base import Role, System
+from .shape import Shape
+from .views import BodiesView, RigidParts
 
 
 class Path:
@@ -47,14 +49,15 @@ class Path:
         return self.position(t), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-class PathFollower(System):
+class PathFollower(System, RigidParts):
     """A rigid mesh carried along a ``Path`` (x forward along the direction of travel).
 
     vertices (n,3) m in the body frame and triangles (m,3); mass (kg) is what the analysis
     divides forces by; dt (s) its output step (the motion is a function of time: any step is
-    exact). Forces are accepted and ignored. Generalized state: (x, y, z, yaw) and its rate."""
+    exact). Forces are ignored. Generalized state: (x, y, z, yaw) and its rate. Its contact view:
+    one prescribed part, its mesh."""
 
-    kind = "kinematic"
+    role = Role.PRESCRIBED
     integrator = "path (monotone cubic Hermite)"
 
     def __init__(self, name, path: Path, vertices, triangles, mass=80.0, dt=1.0 / 60.0):
@@ -66,6 +69,9 @@ class PathFollower(System):
         self.q = np.zeros(4)
         self.qd = np.zeros(4)
         self._place(0.0)
+        self.color = None
+        self._view = BodiesView(self, [name], [(self.body, self.triangles)], [None], [np.inf],
+                                movable=False)
 
     def _place(self, t):
         self.q[:3] = self.path.position(t)
@@ -77,24 +83,40 @@ class PathFollower(System):
     def mass(self):
         return self._mass
 
-    def add_wrench(self, force, torque=None, point=None):
-        """Ignored: the path decides the motion."""
-
-    def add_point_forces(self, indices, forces, dfdx=None, dfdv=None, vref=None):
-        """Ignored: the path decides the motion."""
-
     def step(self, h):
         self.time += h
         self._place(self.time)
 
-    def advance(self, h):
+    def advance(self, h, dt=None):
         self.step(h)
+
+    def _rotation(self):
+        c, s = math.cos(self.q[3]), math.sin(self.q[3])
+        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
     def points(self) -> np.ndarray:
         """The mesh's vertices in the world (m)."""
-        c, s = math.cos(self.q[3]), math.sin(self.q[3])
-        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        return self.body @ R.T + self.q[:3]
+        return self.body @ self._rotation().T + self.q[:3]
+
+    def contact_view(self):
+        return self._view
+
+    def part_poses(self):
+        return self.q[None, :3], self._rotation()[None]
+
+    def part_centres(self):
+        return self.q[None, :3]
+
+    def part_velocities(self, parts=None):
+        k = 1 if parts is None else len(parts)
+        return np.repeat(self.qd[None, :3], k, axis=0), np.zeros((k, 3))
+
+    def centre_of_mass(self):
+        return self.q[:3]
+
+    def shapes(self):
+        return [Shape(self.name, "surface", color=self.color, triangles=self.triangles,
+                      palette="other")]
 
     def lowest_z(self):
         return float(self.points()[:, 2].min())

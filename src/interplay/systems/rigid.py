@@ -1,15 +1,18 @@
 """Free rigid bodies: the basketball, floating balls (SPEC 2.3)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError, require_positive
-import math
-
-from ..kernels.rigid import generalized, kinetic_energy, quat_mul, rigid_step
+from ..kernels.rigid import (Body, Wrench, generalized, kinetic_energy, quat_mul,
+                             quat_to_matrix, rigid_step)
 from .base import GRAVITY, System
+from .shape import Shape
+from ..geometry.primitive import Primitive
+from .views import BodiesView, RigidParts
 
 
 @dataclass(frozen=True)
@@ -21,19 +24,20 @@ class SphereParams:
     dt: float = 1e-3  # s, largest integrator step
 
 
-class RigidBody(System):
+class RigidBody(System, RigidParts):
     """A free rigid body with linear and angular velocity under gravity.
 
     State: position x (m), velocity v (m/s), orientation q (unit quaternion w,x,y,z), angular
     velocity w (rad/s, world frame). Forces and torques about the centre of mass accumulate
-    through ``add_wrench`` and are held constant over a step.
+    through ``add_wrench`` and are held constant over a step. Its contact view is one part:
+    ``surface`` (vertices (n,3) m in the body frame, triangles) and an optional analytic
+    ``primitive`` (systems/views.Primitive).
     """
 
-    kind = "rigid"
     integrator = "exact-ballistic (x += hv + h^2 a/2) with exponential-map rotation"
 
     def __init__(self, name, mass, inertia_body, dt, position=(0, 0, 0), velocity=(0, 0, 0),
-                 angular_velocity=(0, 0, 0), gravity=GRAVITY):
+                 angular_velocity=(0, 0, 0), gravity=GRAVITY, surface=None, primitive=None):
         super().__init__(name, dt)
         self._mass = require_positive(name, "mass", mass, "kg")
         self.inertia_body = np.asarray(inertia_body, dtype=float).reshape(3)
@@ -48,7 +52,14 @@ class RigidBody(System):
         self.torque = np.zeros(3)
         self.kext = np.zeros((3, 3))  # dF/dx (N/m) of the held force, when a contact gives it
         self.dext = np.zeros((3, 3))  # dF/dv (N s/m)
+        self._body = Body(self.x, self.v, self.q, self.w, self._mass, self.inertia_body,
+                          self.gravity)
+        self._wrench = Wrench(self.force, self.torque, self.kext, self.dext)
         self._gx, self._gv = np.zeros(7), np.zeros(7)
+        self.surface = surface
+        self._view = BodiesView(self, [name], [surface if surface is not None else
+                                               (np.zeros((0, 3)), np.zeros((0, 3), np.int64))],
+                                [primitive], [self._mass], movable=True)
 
     @property
     def mass(self) -> float:
@@ -78,9 +89,45 @@ class RigidBody(System):
             self.dext += dfdv
 
     def step(self, h):
-        rigid_step(self.x, self.v, self.q, self.w, self.force, self.torque, self.kext,
-                   self.dext, self.gravity, self._mass, self.inertia_body, h)
+        rigid_step(self._body, self._wrench, h)
 
+    # --- the contact view: one rigid part ------------------------------------------------------
+    def contact_view(self):
+        return self._view
+
+    def part_poses(self):
+        return self.x[None], quat_to_matrix(self.q)[None]
+
+    def part_centres(self):
+        return self.x[None]
+
+    def part_velocities(self, parts=None):
+        rows = [0] if parts is None else np.zeros(len(parts), np.int64)
+        return self.v[None][rows], self.w[None][rows]
+
+    def part_accelerations(self):
+        """Free fall: the acceleration with no interaction acting (what a contact's constraint
+        term cancels; the same whatever order the interactions are evaluated in)."""
+        return self.gravity[None]
+
+    def part_inverse_inertias(self):
+        R = quat_to_matrix(self.q)
+        return (R @ np.diag(1.0 / self.inertia_body) @ R.T)[None]
+
+    def centre_of_mass(self):
+        return self.x
+
+    def add_part_wrench(self, part, force, torque=None, point=None, dfdx=None, dfdv=None):
+        self.add_wrench(force, torque, point, dfdx, dfdv)
+
+    def shapes(self):
+        if self.surface is None:
+            return []
+        v, t = self.surface
+        return [Shape(self.name, "body", verts=np.asarray(v, float), tris=np.asarray(t),
+                      palette="rigid")]
+
+    # --- measures ------------------------------------------------------------------------------
     def kinetic_energy(self):
         return kinetic_energy(self.v, self.q, self.w, self._mass, self.inertia_body)
 
@@ -92,8 +139,9 @@ class RigidBody(System):
     def momentum(self):
         return self._mass * self.v.copy()
 
+    # --- state ---------------------------------------------------------------------------------
     def generalized_state(self):
-        """(position, quaternion) and their rates; buffers are reused: copy to keep them."""
+        """(position, quaternion) and their rates; buffers are reused: copy them to keep them."""
         generalized(self.x, self.v, self.q, self.w, self._gx, self._gv)
         return self._gx, self._gv
 
@@ -105,26 +153,37 @@ class RigidBody(System):
         conj = self.q * np.array([1.0, -1.0, -1.0, -1.0])
         self.w[:] = 2.0 * quat_mul(np.asarray(xdot[3:7], dtype=float), conj)[1:]
 
+    def capture(self):
+        """The body's own state (x, v, q, w: converting to the generalized rates and back
+        would not return w bit for bit) and time."""
+        return {"x": self.x.copy(), "v": self.v.copy(), "q": self.q.copy(),
+                "w": self.w.copy(), "time": np.array(self.time)}
+
+    def restore(self, snap):
+        for key in ("x", "v", "q", "w"):
+            getattr(self, key)[:] = snap[key]
+        self.time = float(snap["time"])
+
     def frame(self):
         return {"position": self.x.copy(), "orientation": self.q.copy()}
 
 
 class Sphere(RigidBody):
-    """A solid sphere (I = 2/5 m r^2) or a thin shell (I = 2/3 m r^2, a basketball)."""
+    """A solid sphere (I = 2/5 m r^2) or a thin shell (I = 2/3 m r^2, a basketball). Its
+    contact and drawn surface is an icosphere of ``subdivisions`` (3: 642 vertices)."""
 
-    def __init__(self, name, params: SphereParams = SphereParams(), **state):
+    def __init__(self, name, params: SphereParams = SphereParams(), subdivisions: int = 3,
+                 **state):
+        from ..geometry.sphere import icosphere
         r = require_positive(name, "radius", params.radius, "m")
         m = require_positive(name, "mass", params.mass, "kg")
         c = 2.0 / 3.0 if params.shell else 2.0 / 5.0
-        super().__init__(name, m, [c * m * r * r] * 3, params.dt, **state)
+        v, t = icosphere(subdivisions)
+        super().__init__(name, m, [c * m * r * r] * 3, params.dt, surface=(v * r, t),
+                         primitive=Primitive("sphere", radius=r), **state)
         self.radius = r
         self.params = params
 
     def lowest_z(self) -> float:
         """Height (m) of the sphere's lowest point."""
         return float(self.x[2] - self.radius)
-
-    def surface(self, subdivisions: int = 2):
-        from ..geometry.sphere import icosphere
-        verts, tris = icosphere(subdivisions)
-        return verts * self.radius, tris

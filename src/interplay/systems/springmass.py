@@ -13,13 +13,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
+from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
+                      require_positive)
 from ..kernels import localglobal as LG
 from ..kernels import multigrid as MG
 from ..kernels import parallel as PAR
 from ..kernels import springs as K
-from ..kernels.subcycle import substep_with_spheres
-from .base import GRAVITY, System
+from ..kernels.contact import colliders as no_colliders
+from ..kernels.subcycle import advance_with_colliders
+from .base import GRAVITY, System, substeps
+from .shape import Shape
+from .views import PointsView
 
 INTEGRATORS = ("explicit", "implicit", "localglobal")
 SCHEMES = ("bdf2", "theta")
@@ -80,15 +84,18 @@ class SpringNetwork(System):
     MULTIGRID_MIN_POINTS free points. parallel:
     explicit spring forces on all threads (per spring, then a per-point gather: equal to the
     serial kernel to round-off); opt-in: on 2 cores it measured slower (``kernels/parallel.py``).
+    triangles (m,3): its faces, when it is a surface (cloth), for contacts, aerodynamics and
+    drawing; cord_radius (m): the cords' radius as drawn and as a contact skin (None: drawn
+    at 8% of the median spring length); color: linear RGB (0..1) as drawn (None: the
+    outputs' default).
     """
-
-    kind = "springmass"
 
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
                  mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
                  scheme="theta", theta=1.0, lg_iterations=10, lg_memory=3,
-                 lg_tolerance=1e-4, lg_solver="auto", parallel=False):
+                 lg_tolerance=1e-4, lg_solver="auto", parallel=False, triangles=None,
+                 cord_radius=None, color=None):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -142,9 +149,7 @@ class SpringNetwork(System):
         self.kvref = np.zeros_like(x)
         self._f = np.zeros_like(x)
         self._jac = False
-        self._spheres: list = []
-        self._seg = None
-        self.impulses = np.zeros((0, 7))
+        self._cols = None  # the colliders sub-cycled in the next advance, and their elements
         self.cg_iterations = 0
         self.lg_iterations = int(require_positive(name, "lg_iterations", lg_iterations))
         self.lg_memory = int(require_nonnegative(name, "lg_memory", lg_memory))
@@ -156,10 +161,30 @@ class SpringNetwork(System):
         self.lg_taken = 0  # iterations taken in the last advance
         self.lg_objective = np.zeros(2)  # the last step's objective at its first guess and end
         self._lg = None  # the factored local/global matrix and what it was built from
+        self._lg_pending = None  # a restored L-BFGS history waiting for its matrix
         self.lg_factorizations = 0
         # point -> spring adjacency (CSR) for the parallel explicit kernel
         self._adj = (PAR.adjacency(len(x), self.si, self.sj, self.a_idx) if parallel else None)
+        self.triangles = None if triangles is None else np.asarray(triangles, np.int64)
+        self.cord_radius = None if cord_radius is None else require_positive(
+            name, "cord_radius", cord_radius, "m")
+        self.color = color
+        self._pts = K.Points(self.x, self.v, self.m, self.fixed)
+        self._load = K.Load(self.fext, self.kext, self.dext, self.kvref)
+        self._view = None
         self.check_step(self.dt)
+
+    def bundle(self, alpha=None) -> K.Network:
+        """The kernels' bundle of this network (with mass damping alpha, default its own)."""
+        return K.Network(self._pts,
+                         K.SpringSet(self.si, self.sj, self.l0, self.k, self.kd,
+                                     self.tension_only),
+                         K.Anchors(self.a_idx, self.a_pos, self.a_k, self.a_c),
+                         self.alpha if alpha is None else alpha, self.gravity)
+
+    def _scheme(self) -> K.Scheme:
+        return K.Scheme(self.integrator == "implicit", self.theta, self.scheme == "bdf2",
+                        self.cg_tolerance, self.cg_max_iter, self.xp, self.vp)
 
     @classmethod
     def from_mesh(cls, name, vertices, triangles, total_mass, stretch, shear=None, bend=None,
@@ -189,8 +214,7 @@ class SpringNetwork(System):
         rest = np.linalg.norm(x[ms.pairs[:, 0]] - x[ms.pairs[:, 1]], axis=1)
         springs = Springs(ms.pairs[:, 0].copy(), ms.pairs[:, 1].copy(), rest, k,
                           np.zeros(len(rest), dtype=bool))
-        net = cls(name, x, ms.masses, springs, **kw)
-        net.triangles = t
+        net = cls(name, x, ms.masses, springs, triangles=t, **kw)
         net.spring_kind = ms.kind
         return net
 
@@ -234,7 +258,7 @@ class SpringNetwork(System):
         return float(self.m.sum())
 
     def clear_forces(self):
-        self._spheres.clear()
+        self._cols = None
         self.fext[:] = 0.0
         if self._jac:
             self.kext[:] = 0.0
@@ -248,107 +272,127 @@ class SpringNetwork(System):
         body); the implicit integrator uses them to keep stiff external couplings stable."""
         idx = np.asarray(indices, dtype=np.int64)
         f = np.asarray(forces, dtype=float).reshape(-1, 3)
+        zero = np.zeros((0, 3, 3))
         if dfdx is None:
-            K.scatter_forces(idx, f, self.kext, self.dext, f, self.fext, self.kext, self.dext,
-                             self.kvref, False)
+            pf = K.PointForces(idx, f, zero, zero, f)
+            K.scatter_forces(pf, len(idx), self._load, False)
         else:
             vr = np.zeros_like(f) if vref is None else vref
-            K.scatter_forces(idx, f, dfdx, dfdv, vr, self.fext, self.kext, self.dext,
-                             self.kvref, True)
+            K.scatter_forces(K.PointForces(idx, f, dfdx, dfdv, vr), len(idx), self._load, True)
             self._jac = True
 
-    def add_moving_sphere(self, segments, centre, velocity, spin, accel, radius, mass,
-                          contact) -> int:
-        """Collide a sphere with these segments at every substep of the next ``advance``
-        (segments None: with the points; explicit and localglobal only, ~3x cheaper for cloth).
+    def substeps(self, h) -> int:
+        """Substeps of the next advance of h (s) at this network's own step."""
+        return substeps(h, self.dt)
 
-        The sphere moves along c0 + v t + a t^2/2 over the step (m, m/s, m/s^2; spin rad/s);
-        contact = (thickness m, c_s N/m, c_d N s/m, mu, eps m/s, constraint 0/1). After the
-        advance, ``impulses[slot]`` holds the impulse (N s) and angular impulse (N m s) the
-        cords exerted on the sphere over the step, and the peak force (N) of any substep.
-        Returns the slot.
-        """
-        if segments is None and self.integrator == "implicit":
-            raise ParameterError(f"{self.name}: point contacts (segments=None) need the explicit "
-                                 "or localglobal integrator; pass the segments for implicit")
-        self._seg = segments
-        self._spheres.append((centre, velocity, spin, accel, radius, mass, contact))
-        return len(self._spheres) - 1
+    def subcycle(self, colliders, elements) -> bool:
+        """The sub-cycling hook (PointsView.subcycle): collide kernels.contact.Colliders with
+        ``elements`` ((s,2) point pairs; (p, p) for points) at every substep of the next
+        ``advance`` (local/global: after every step, points only). One batch per advance; a
+        second with the same elements is merged."""
+        elems = np.ascontiguousarray(elements, dtype=np.int64)
+        if self._cols is None:
+            self._cols = (colliders, elems, [colliders])
+            return True
+        cols, old, parts = self._cols
+        if old.shape != elems.shape or not np.array_equal(old, elems):
+            raise SceneError(f"{self.name}: two sub-cycled contacts with different elements in "
+                             "one coupling step; give them the same elements or exchange one "
+                             "of them in lock step")
+        parts.append(colliders)
+        merged = type(cols)(*(np.concatenate([getattr(c, f) for c in parts])
+                              for f in cols._fields))
+        self._cols = (merged, old, parts)
+        return True
 
-    def _sphere_arrays(self):
-        sp = self._spheres
-        arr = [np.array([s[i] for s in sp], dtype=float).reshape(len(sp), *shape)
-               for i, shape in enumerate(((3,), (3,), (3,), (3,), (), (), (6,)))]
-        self.impulses = np.zeros((len(sp), 7))
-        return arr
-
-    def _advance_with_spheres(self, h, n):
-        arr = self._sphere_arrays()
-        substep_with_spheres(
-            self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
-            self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha,
-            self.gravity, self.fext, self.kext, self.dext, self.kvref, self._f, h, n,
-            self.integrator == "implicit", self.theta, self.scheme == "bdf2", self.has_prev,
-            self.xp, self.vp, self.cg_tolerance, self.cg_max_iter,
-            self._seg, arr[0], arr[1], arr[2], arr[4], arr[5], arr[3], arr[6], self.impulses)
-        self.has_prev = self.scheme == "bdf2"
-        self.time += h
+    def _return_impulses(self):
+        """Hand each sub-cycled batch its own rows of the merged impulses."""
+        cols, _, parts = self._cols
+        if len(parts) > 1:
+            k = 0
+            for c in parts:
+                n = len(c.impulses)
+                c.impulses[:] = cols.impulses[k:k + n]
+                k += n
 
     def internal_forces(self) -> np.ndarray:
         """Total force (N) on each point from springs, anchors, damping, gravity and externals."""
-        K.network_forces(self.x, self.v, self.m, self.si, self.sj, self.l0, self.k, self.kd,
-                         self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
-                         self.alpha, self.gravity, self.fext, self._f)
+        K.network_forces(self.bundle(), self.fext, self._f)
         return self._f
 
+    def accelerations(self) -> np.ndarray:
+        """(n,3) accelerations (m/s^2) from every force now acting on the points."""
+        return self.internal_forces() / self.m[:, None]
+
+    def contact_view(self) -> PointsView:
+        if self._view is None:
+            self._view = PointsView(self, self._pts, self.triangles, self.segments(),
+                                    self.cord_radius or 0.0, self.integrator == "implicit")
+        return self._view
+
+    def shapes(self):
+        anchors = self.a_pos.copy() if len(self.a_pos) else None
+        if self.triangles is not None:
+            return [Shape(self.name, "surface", color=self.color, triangles=self.triangles,
+                          anchors=anchors, palette="cloth")]
+        seg = self.segments()
+        if self.cord_radius is not None:
+            width = 2.0 * self.cord_radius
+        elif len(seg):
+            lengths = np.linalg.norm(self.x[seg[:, 0]] - self.x[seg[:, 1]], axis=1)
+            width = float(np.clip(0.08 * np.median(lengths), 0.002, 0.02))
+        else:
+            width = 0.005
+        return [Shape(self.name, "cords", color=self.color, segments=seg, width=width,
+                      anchors=anchors, palette="cloth")]
+
     def _factors(self, h):
-        """The local/global preconditioner for step h (the factor, or a multigrid hierarchy and
-        its workspace) and the L-BFGS history, rebuilt only when the step, the masses, the
-        damping, the springs, the anchors, the fixed set, the solver or the memory changed."""
+        """The local/global preconditioner for step h (kernels.localglobal.Factors) and the
+        L-BFGS History, rebuilt only when the step, the masses, the damping, the springs, the
+        anchors, the fixed set, the solver or the memory changed."""
         arrays = (self.m, self.fixed, self.si, self.sj, self.k, self.a_idx, self.a_k, self.a_c)
         lg = self._lg
         key = (h, self.alpha, self.beta, self.lg_solver, self.lg_memory)
         if (lg is None or lg[0] != key
                 or not all(np.array_equal(a, b) for a, b in zip(arrays, lg[1]))):
-            fid, A = LG.system_matrix(self.m, self.fixed, self.si, self.sj, self.k, self.a_idx,
-                                      self.a_k, self.a_c, self.alpha, self.beta, h)
+            fid, A = LG.system_matrix(self.bundle(), self.beta, h)
             if self._multigrid(A.shape[0]):
                 hier = MG.hierarchy(A)
-                pre = (LG.NO_DIRECT, (*hier, *MG.workspace(hier)))
+                pre = LG.Factors(fid, LG.NO_DIRECT, hier, MG.workspace(hier))
             else:
-                pre = (LG.factor(A), LG.NO_MULTIGRID)
+                pre = LG.Factors(fid, LG.factor(A), LG.NO_MULTIGRID, LG.NO_WORKSPACE)
             # L-BFGS pairs (kept across steps while the matrix is unchanged) and their count
             nf, slots = A.shape[0], self.lg_memory + 1
-            history = (np.zeros((slots, nf, 3)), np.zeros((slots, nf, 3)), np.zeros(slots),
-                       np.zeros(1, np.int64))
-            self._lg = lg = (key, tuple(a.copy() for a in arrays), (fid, *pre, *history))
+            history = LG.History(np.zeros((slots, nf, 3)), np.zeros((slots, nf, 3)),
+                                 np.zeros(slots), np.zeros(1, np.int64))
+            pending = self._lg_pending
+            if pending is not None and pending[0] == key:
+                for mine, saved in zip(history, pending[1]):
+                    mine[...] = saved
+            self._lg_pending = None
+            self._lg = lg = (key, tuple(a.copy() for a in arrays), pre, history)
             self.lg_factorizations += 1
-        return lg[2]
+        return lg[2], lg[3]
 
     def _multigrid(self, unknowns):
         return self.lg_solver == "multigrid" or (
             self.lg_solver == "auto" and unknowns >= MULTIGRID_MIN_POINTS)
 
     def _localglobal(self, h, n):
-        """n local/global steps of h/n with the held forces and any moving spheres."""
-        arr = self._sphere_arrays()
-        fid, direct, mg, *history = self._factors(h / n)
+        """n local/global steps of h/n with the held forces and any sub-cycled colliders."""
+        pre, history = self._factors(h / n)
+        cols = self._cols[0] if self._cols is not None else no_colliders(0)
         self.lg_taken = LG.localglobal_steps(
-            self.x, self.v, self.m, fid, self.si, self.sj, self.l0, self.k, self.tension_only,
-            self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha, self.beta, self.gravity,
-            self.fext, h / n, n, self.lg_iterations, self.lg_tolerance, direct, mg, *history, arr[0], arr[1], arr[3], arr[4], arr[6],
-            self.impulses, self.lg_objective)
+            self.bundle(), self.fext, pre, history,
+            LG.Settings(self.beta, self.lg_iterations, self.lg_tolerance), h / n, n, cols,
+            self.lg_objective)
 
     def _explicit(self, h, n):
         """n symplectic-Euler steps of h s with the held forces, serial or parallel."""
         if self._adj is None:
-            K.explicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k,
-                            self.kd, self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c,
-                            self.alpha, self.gravity, self.fext, self._f, h, n)
+            K.explicit_step(self.bundle(), self.fext, self._f, h, n)
         else:
-            PAR.explicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0,
-                              self.k, self.kd, self.tension_only, self.a_pos, self.a_k, self.a_c,
-                              self.alpha, self.gravity, self.fext, self._f, h, n, self._adj)
+            PAR.explicit_step(self.bundle(), self.fext, self._f, h, n, self._adj)
 
     def step(self, h):
         if self.integrator == "localglobal":
@@ -356,51 +400,39 @@ class SpringNetwork(System):
         elif self.integrator == "explicit":
             self._explicit(h, 1)
         else:
-            self.cg_iterations = K.implicit_step(
-                self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
-                self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha,
-                self.gravity, self.fext, self.kext, self.dext, self.kvref, self._f, h, self.theta,
-                self.scheme == "bdf2", self.has_prev, self.xp, self.vp, self.cg_tolerance,
-                self.cg_max_iter)
+            self.cg_iterations = K.implicit_step(self.bundle(), self._load, self._f, h,
+                                                 self._scheme(), self.has_prev)
             self.has_prev = self.scheme == "bdf2"
 
-    def advance(self, h):
+    def advance(self, h, dt=None):
         # Explicit substeps with held forces run inside one kernel call (no Python per substep).
-        n = max(1, int(np.ceil(h / self.dt - 1e-9)))
+        n = substeps(h, self.dt if dt is None else dt)
         if self.integrator == "localglobal":
             self._localglobal(h, n)
-            self.time += h
-        elif self._spheres and self._seg is None:
-            arr = self._sphere_arrays()
-            K.explicit_step_point_spheres(
-                self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0, self.k, self.kd,
-                self.tension_only, self.a_idx, self.a_pos, self.a_k, self.a_c, self.alpha,
-                self.gravity, self.fext, self._f, h, n, *arr[:4], arr[4], arr[5], arr[6],
-                self.impulses)
-            self.time += h
-        elif self._spheres:
-            self._advance_with_spheres(h, n)
+        elif self._cols is not None:
+            cols, elems, _ = self._cols
+            advance_with_colliders(self.bundle(), self._load, self._f, h, n, self._scheme(),
+                                   self.has_prev, cols, elems)
+            self.has_prev = self.scheme == "bdf2" and self.integrator == "implicit"
         elif self.integrator == "explicit" and n > 1:
             self._explicit(h / n, n)
-            self.time += h
         else:
-            super().advance(h)
+            super().advance(h, dt)
+            return
+        if self._cols is not None:
+            self._return_impulses()
+        self.time += h
 
     def settle(self, seconds=1.0, h=2e-3, damping=30.0):
         """Let the network sag to rest under gravity alone (implicit, heavily damped), v = 0 after."""
-        alpha = self.alpha
-        self.alpha = damping
         saved = self.fext.copy()
         self.fext[:] = 0.0
         try:
+            net = self.bundle(alpha=damping)
+            scheme = K.Scheme(True, 1.0, False, 1e-10, 1000, self.xp, self.vp)
             for _ in range(int(round(seconds / h))):
-                K.implicit_step(self.x, self.v, self.m, self.fixed, self.si, self.sj, self.l0,
-                                self.k, self.kd, self.tension_only, self.a_idx, self.a_pos,
-                                self.a_k, self.a_c, self.alpha, self.gravity, self.fext, self.kext,
-                                self.dext, self.kvref, self._f, h, 1.0, False, False,
-                                self.xp, self.vp, 1e-10, 1000)
+                K.implicit_step(net, self._load, self._f, h, scheme, False)
         finally:
-            self.alpha = alpha
             self.fext[:] = saved
         self.v[:] = 0.0
         self.has_prev = False
@@ -408,7 +440,8 @@ class SpringNetwork(System):
     # --- measures --------------------------------------------------------------------------
     def strain(self) -> float:
         """Largest spring strain (l - l0) / l0 (dimensionless)."""
-        return float(K.max_strain(self.x, self.si, self.sj, self.l0)) if len(self.si) else 0.0
+        return float(K.max_strain(self.x, K.SpringSet(self.si, self.sj, self.l0, self.k, self.kd,
+                                                     self.tension_only))) if len(self.si) else 0.0
 
     def lowest_z(self) -> float:
         """Lowest point height (m)."""
@@ -438,6 +471,39 @@ class SpringNetwork(System):
         self.x[:] = np.reshape(x, self.x.shape)
         self.v[:] = np.reshape(xdot, self.v.shape)
         self.has_prev = False  # a jump in state: BDF2 restarts with a backward-Euler step
+
+    def capture(self):
+        """Points, time and all solver memory: BDF2's previous state and the L-BFGS pairs
+        (with the matrix key they belong to), so a restore and a rerun repeat bit for bit."""
+        snap = {"x": self.x.copy(), "v": self.v.copy(), "time": np.array(self.time),
+                "has_prev": np.array(self.has_prev), "xp": self.xp.copy(),
+                "vp": self.vp.copy()}
+        if self._lg is not None:
+            snap["lg_key"] = np.array(self._lg[0][:3], dtype=float)
+            snap["lg_solver"] = np.array(self._lg[0][3])
+            snap["lg_memory"] = np.array(self._lg[0][4])
+            for f, a in zip(LG.History._fields, self._lg[3]):
+                snap[f"lg_{f}"] = a.copy()
+        return snap
+
+    def restore(self, snap):
+        self.x[:], self.v[:] = snap["x"], snap["v"]
+        self.time = float(snap["time"])
+        self.has_prev = bool(snap["has_prev"])
+        self.xp[:], self.vp[:] = snap["xp"], snap["vp"]
+        self._lg_pending = None
+        if "lg_key" in snap:
+            h, alpha, beta = (float(v) for v in snap["lg_key"])
+            key = (h, alpha, beta, str(snap["lg_solver"]), int(snap["lg_memory"]))
+            saved = tuple(snap[f"lg_{f}"] for f in LG.History._fields)
+            if self._lg is not None and self._lg[0] == key:
+                for mine, s in zip(self._lg[3], saved):
+                    mine[...] = s
+            else:
+                self._lg_pending = (key, saved)
+        elif self._lg is not None:  # captured before any local/global step: start afresh
+            for a in self._lg[3]:
+                a[...] = 0
 
     def frame(self):
         return {"points": self.x.copy()}

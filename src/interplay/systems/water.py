@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
 from ..kernels import water as K
 from .base import System
+from .shape import Shape
 
 #: the wave-speed stability limit: dt < STABLE_CFL * l / sqrt(g d) (the pipe update is stable
 #: up to 1.0 for the fastest 8-pipe mode; 0.7 leaves room for depth growing within a step)
@@ -70,7 +71,6 @@ class Water(System):
     (kernels/water.py ``heads``); ``clear_forces`` forgets them.
     """
 
-    kind = "water"
     integrator = "virtual pipes (O'Brien & Hodgins 1995), staggered flow update"
 
     def __init__(self, name, bed, fluid, depth, spacing, origin=(0.0, 0.0),
@@ -154,10 +154,16 @@ class Water(System):
         self._track = np.array([0.0, float(d[fluid].min())])  # peak particles, min depth
         self.volume0 = self.total_volume()
         self._drift = 0.0
-        self._eta = np.zeros(bed.shape)
-        self._H = np.zeros(bed.shape)
-        self._work = np.zeros(bed.shape)
         self._em = np.zeros(4)
+        self._grid = K.Grid(self.bed, self.fluid, self.pipe, self.nearest, self.area,
+                            self.origin[0], self.origin[1], self.spacing, self.pipe_width)
+        self._state = K.State(self.V, self.Q, self.ext, self.rate, self.px, self.pv, self._track)
+        self._settings = K.Settings(self.g, self.kappa, float(p.damping), float(p.body_damping),
+                                    float(p.cfl), self.spray_on, float(s.threshold),
+                                    float(s.fraction), self.particle_volume, float(s.radius),
+                                    self.air_drag)
+        self._scratch = K.Scratch(np.zeros(bed.shape), np.zeros(bed.shape), np.zeros(bed.shape))
+        self.color = None
 
     # --- the System protocol -----------------------------------------------------------------
     @property
@@ -174,32 +180,25 @@ class Water(System):
         arrays = (np.zeros(cap, np.int64), np.zeros((cap, s2)), np.zeros((cap, s2)),
                   np.zeros(cap), np.zeros(cap))
         if old:
-            for new, cur in zip(arrays, self._lids()):
+            for new, cur in zip(arrays, self._lids):
                 new[:old] = cur[:old]
-        self.lid_cell, self.lid_zlo, self.lid_zhi, self.lid_scale, self.lid_vz = arrays
+        self._lids = K.Lids(*arrays)
         self.n_lid = old
 
-    def _lids(self):
-        return self.lid_cell, self.lid_zlo, self.lid_zhi, self.lid_scale, self.lid_vz
-
     def _run(self, h, dt_max):
-        s = self.params.spray
-        self.count, _ = K.advance(
-            self.V, self.Q, self.bed, self.pipe, self.fluid, self.nearest, self.area,
-            *self._lids(), self.n_lid, self.kappa, self.ext,
-            self.origin[0], self.origin[1], self.spacing, self.g, self.pipe_width,
-            self.params.damping, self.params.body_damping, h, dt_max, self.params.cfl,
-            self._eta, self._H, self._work, self.rate, self.spray_on, s.threshold, s.fraction, self.particle_volume, s.radius,
-            self.air_drag, self.px, self.pv, self.count, self._steps & 0xFFFFFFFF, self._track)
+        self.count, _ = K.advance(self._grid, self._state, self._lids, self.n_lid,
+                                  self._settings, self._scratch, self.count,
+                                  self._steps & 0xFFFFFFFF, h, dt_max)
         self._steps += 1
 
     def step(self, h):
         """One step of h seconds (split further only if h breaks the wave-speed limit)."""
         self._run(h, h)
 
-    def advance(self, h):
-        """A coupling step of h seconds in equal substeps inside one kernel call."""
-        self._run(h, self.dt)
+    def advance(self, h, dt=None):
+        """A coupling step of h seconds in equal substeps no longer than dt (s, default the
+        water's own) inside one kernel call."""
+        self._run(h, self.dt if dt is None else dt)
         self.time += h
 
     def total_volume(self) -> float:
@@ -209,9 +208,9 @@ class Water(System):
     def heights(self) -> np.ndarray:
         """(nx, ny) surface heights (m): bed + depth + external pressure head (the water
         pushed up around a body)."""
-        K.heads(self.V, self.bed, self.area, *self._lids()[:4], self.n_lid, self.kappa,
-                self.ext, self._eta, self._H)
-        return self._H.copy()
+        sc = self._scratch
+        K.heads(self._grid, self.V, self._lids, self.n_lid, self.kappa, self.ext, sc.eta, sc.H)
+        return sc.H.copy()
 
     def column_centres(self):
         """(nx, ny) x and y (m) of the column centres."""
@@ -234,6 +233,17 @@ class Water(System):
         tris = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
         return verts, tris
 
+    def shapes(self):
+        """The surface (a height field over the columns) and its spray."""
+        _, tris = self.surface()
+        X, Y = self.column_centres()
+        out = [Shape(self.name, "surface", color=self.color, triangles=np.asarray(tris, np.int64),
+                     grid_xy=np.stack([X.ravel(), Y.ravel()], axis=1))]
+        if self.spray_on:
+            out.append(Shape(f"{self.name}-spray", "particles", color=self.color,
+                             width=2.0 * self.params.spray.radius, source=(self.name, "particles")))
+        return out
+
     def frame(self):
         """heights (nx, ny) m and surface_vz (nx, ny) m/s; particles (capacity, 3) m and
         particle_radius (capacity,) m, NaN past particle_count, so frames stack."""
@@ -254,8 +264,8 @@ class Water(System):
         return self._em[1:].copy()
 
     def _energy(self):
-        K.energy_momentum(self.V, self.Q, self.pipe, self.fluid, self.area, self.pipe_width,
-                          self.rho, self.px, self.pv, self.count, self.particle_volume, self._em)
+        K.energy_momentum(self._grid, self._state, self.rho, self.count, self.particle_volume,
+                          self._em)
 
     def health(self):
         n = self.count
@@ -317,12 +327,11 @@ class Water(System):
         valid until the next call)."""
         start = self.n_lid
         while True:
-            n = K.add_ellipsoid(centre, vz, A, M, volume, self.fluid, self.origin[0],
-                                self.origin[1], self.spacing, self.samples, *self._lids()[:4],
-                                self.lid_vz, start)
+            n = K.add_ellipsoid(centre, vz, A, M, volume, self._grid, self.samples, self._lids,
+                                start)
             if n >= 0:
                 break
-            self._grow_lids(2 * self.lid_cell.shape[0])
+            self._grow_lids(2 * self._lids.cell.shape[0])
         if keep:
             self.n_lid = n
         return start, n
@@ -331,10 +340,7 @@ class Water(System):
         """The water's push on a body from its lids (``add_ellipsoid``): out (7,) receives
         the displaced volume (m^3; rho g times it is the buoyancy), the centre of buoyancy (m)
         and the water's velocity there (m/s)."""
-        K.lid_load(self.V, self.Q, self.pipe, self.bed, self.area, self.rate,
-                   self.lid_cell, self.lid_zlo, self.lid_zhi,
-                   self.lid_scale, lids[0], lids[1], self.kappa, self.origin[0],
-                   self.origin[1], self.spacing, self.pipe_width, out)
+        K.lid_load(self._grid, self._state, self._lids, lids[0], lids[1], self.kappa, out)
         return out
 
 

@@ -69,8 +69,6 @@ class WindField(Stateless):
     """The air: a stateless system (never stepped by the scheduler, infinitely massive) whose
     ``velocity(points, t)`` any interaction may sample; it is a function of time."""
 
-    kind = "wind"
-
     def __init__(self, name="wind", primitives=()):
         super().__init__(name)
         self.primitives = [p.checked(name) for p in primitives]

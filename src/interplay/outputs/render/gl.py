@@ -66,7 +66,7 @@ def quat_matrix4(pos, q) -> np.ndarray:
 
 def ground_shape(lo, hi):
     """A floor quad (a static Shape) just under the box [lo, hi], 20 m or 10 box sizes wide."""
-    from ..rundata import Shape
+    from ...systems.shape import Shape
     c = (np.asarray(lo) + np.asarray(hi)) / 2
     s = max(10.0, 5 * float(np.max(np.asarray(hi) - np.asarray(lo))))
     z = float(lo[2]) - 1e-3

@@ -1,4 +1,4 @@
-"""BVH against brute force: overlaps, nearest triangles, refit bounds, transformed boxes, and
+"""AABBTree against brute force: overlaps, nearest triangles, refit bounds, transformed boxes, and
 triangle-triangle intersection against an exact rational reference."""
 from fractions import Fraction
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from interplay.errors import ParameterError
-from interplay.geometry.aabb_tree import BVH
+from interplay.geometry.aabb_tree import AABBTree
 from interplay.kernels.trimesh_contact import closest_on_triangle, triangles_intersect
 
 
@@ -32,7 +32,7 @@ def test_overlap_pairs_equal_brute_force(sliver):
     rng = np.random.default_rng(1 if sliver else 0)
     xa, ta = random_soup(rng, 400, sliver=sliver)
     xb, tb = random_soup(rng, 300, sliver=sliver)
-    a, b = BVH(xa, ta), BVH(xb, tb)
+    a, b = AABBTree(xa, ta), AABBTree(xb, tb)
     got = {tuple(p) for p in a.overlapping(b)}
     brute = np.argwhere(boxes_overlap(np.vstack([xa, xb]), ta, tb + len(xa)))
     assert got == {tuple(p) for p in brute}
@@ -42,7 +42,7 @@ def test_overlap_pairs_equal_brute_force(sliver):
 def test_self_overlap_each_pair_once():
     rng = np.random.default_rng(2)
     x, t = random_soup(rng, 500)
-    pairs = BVH(x, t).overlapping()
+    pairs = AABBTree(x, t).overlapping()
     got = {tuple(sorted(p)) for p in pairs}
     assert len(got) == len(pairs)
     ov = boxes_overlap(x, t, t)
@@ -64,7 +64,7 @@ def test_nearest_triangle_equals_brute_force(sliver):
     rng = np.random.default_rng(3 if sliver else 4)
     x, t = random_soup(rng, 300, sliver=sliver)
     pts = rng.uniform(-1.1, 1.1, (1500, 3))
-    tri, d, bary = BVH(x, t).nearest(pts, 0.15)
+    tri, d, bary = AABBTree(x, t).nearest(pts, 0.15)
     for i in range(len(pts)):
         bt, bd = brute_nearest(pts[i], x, t, 0.15)
         assert (tri[i] >= 0) == (bt >= 0)
@@ -79,7 +79,7 @@ def test_nearest_triangle_equals_brute_force(sliver):
 def test_refit_bounds_contain_deformed_triangles():
     rng = np.random.default_rng(5)
     x, t = random_soup(rng, 500)
-    tree = BVH(x, t, pad=0.01)
+    tree = AABBTree(x, t, pad=0.01)
     for _ in range(20):
         x0 = x + rng.normal(0, 0.2, x.shape)
         x1 = x0 + rng.normal(0, 0.05, x.shape)
@@ -98,7 +98,7 @@ def test_transformed_boxes_contain_moved_rigid_mesh():
     from interplay.geometry.sphere import icosphere
     rng = np.random.default_rng(6)
     v, t = icosphere(2)
-    tree = BVH(v * 0.3, t)
+    tree = AABBTree(v * 0.3, t)
     for _ in range(20):
         q = rng.normal(size=4)
         q /= np.linalg.norm(q)
@@ -167,9 +167,9 @@ def test_triangle_intersection_matches_exact_reference():
 def test_mesh_intersections_found_by_tree():
     from interplay.geometry.sphere import icosphere
     v, t = icosphere(2)
-    a = BVH(v * 0.1, t)
-    b = BVH(v * 0.1 + [0.15, 0, 0], t)
-    c = BVH(v * 0.1 + [0.25, 0, 0], t)
+    a = AABBTree(v * 0.1, t)
+    b = AABBTree(v * 0.1 + [0.15, 0, 0], t)
+    c = AABBTree(v * 0.1 + [0.25, 0, 0], t)
     assert len(a.intersections(b)) > 0
     assert len(a.intersections(c)) == 0
     assert len(a.intersections()) == 0  # a closed sphere never crosses itself
@@ -177,14 +177,14 @@ def test_mesh_intersections_found_by_tree():
 
 def test_bad_meshes_are_refused_with_the_fix():
     with pytest.raises(ParameterError, match=r"cloth: a collision mesh needs at least one"):
-        BVH(np.zeros((3, 3)), np.zeros((0, 3), np.int64), owner="cloth")
+        AABBTree(np.zeros((3, 3)), np.zeros((0, 3), np.int64), owner="cloth")
     x = np.eye(3)
     x[1, 2] = np.nan
     with pytest.raises(ParameterError, match=r"cloth: vertices of point 1 is not finite.*fix"):
-        BVH(x, [[0, 1, 2]], owner="cloth")
+        AABBTree(x, [[0, 1, 2]], owner="cloth")
     with pytest.raises(ParameterError, match=r"cloth: contact thickness must be zero or "
                                              r"positive \(m\), got -0.1"):
-        BVH(np.eye(3), [[0, 1, 2]], owner="cloth", pad=-0.1)
+        AABBTree(np.eye(3), [[0, 1, 2]], owner="cloth", pad=-0.1)
 
 
 def test_edge_edge_proximity_equals_brute_force():
@@ -201,7 +201,7 @@ def test_edge_edge_proximity_equals_brute_force():
     xa, ea = segments(400)
     xb, eb = segments(300)
     # each tree grows its boxes by half the reach: boxes of segments closer than reach overlap
-    ta, tb = BVH(xa, ea, pad=reach / 2), BVH(xb, eb, pad=reach / 2)
+    ta, tb = AABBTree(xa, ea, pad=reach / 2), AABBTree(xb, eb, pad=reach / 2)
     pairs, st, d = ta.edge_contacts(tb, reach)
     got = {tuple(p): dd for p, dd in zip(pairs, d)}
     brute = {}

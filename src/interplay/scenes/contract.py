@@ -1,0 +1,93 @@
+"""The scene contract: every scene registers one ``SceneSpec``, and the command line checks a
+request against it before anything is simulated."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+from ..coupling.modes import MODES
+from ..errors import ParameterError, SceneError
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    """What a scene is and what it supports.
+
+    name, description (one line, for ``interplay list``); build(coupling, duration, fps,
+    integrator, dt, params) -> Scene; params: its parameter dataclass (``--set`` keys);
+    couplings: the coupling modes it supports, default first; duration (s) and fps: defaults;
+    integrators: the ``--integrator`` values that apply (empty: none does, e.g. the water has
+    one); standin: the params field holding its hybrid stand-in's coefficients when
+    ``interplay fit-standin`` can fit them, with fit_time (s): the time at which the
+    primary's velocity is matched; camera: its default preview camera (None: frame every
+    system); figures: result -> {label: value}, the scene's own key figures (the basketball's
+    exit speed) for summaries and compare tables.
+    """
+    name: str
+    description: str
+    build: Callable
+    params: type
+    couplings: tuple = MODES
+    duration: float = 1.5
+    fps: float = 60.0
+    integrators: tuple = ()
+    standin: str | None = None
+    fit_time: float | None = None
+    camera: object = None
+    figures: Callable | None = field(default=None, compare=False)
+
+    @property
+    def default_coupling(self) -> str:
+        return self.couplings[0]
+
+    def check_coupling(self, mode: str | None) -> str:
+        """The coupling to run (the default for None); one-line errors for the others."""
+        if mode is None:
+            return self.default_coupling
+        if mode not in MODES:
+            raise ParameterError(f"--coupling {mode}: unknown coupling; choose one of "
+                                 f"{', '.join(MODES)}")
+        if mode not in self.couplings:
+            raise SceneError(f"{self.name} supports {_list(self.couplings)} coupling, not {mode}"
+                             f"{self._why(mode)}")
+        return mode
+
+    def _why(self, mode) -> str:
+        if mode == "hybrid":
+            return " (it has no stand-in for hybrid)"
+        return ""
+
+    def check_integrator(self, integrator: str | None) -> str | None:
+        if integrator is None:
+            return None
+        if not self.integrators:
+            raise ParameterError(f"{self.name}: --integrator {integrator} does not apply: its "
+                                 "systems have one integrator each; leave it out")
+        if integrator not in self.integrators:
+            raise ParameterError(f"--integrator {integrator}: choose one of "
+                                 f"{', '.join(self.integrators)}")
+        return integrator
+
+    def check_compare(self):
+        """compare runs every supported coupling; a scene with one has nothing to compare."""
+        if len(self.couplings) < 2:
+            raise SceneError(f"{self.name} supports only {_list(self.couplings)} coupling: "
+                             "there is nothing to compare; use `interplay run "
+                             f"{self.name}`")
+
+    def check_fit(self):
+        if self.standin is None or self.fit_time is None:
+            raise SceneError(f"{self.name} has no stand-in that fit-standin can fit"
+                             f"{'' if 'hybrid' in self.couplings else ' (no hybrid coupling)'}"
+                             "; scenes with one: "
+                             f"{', '.join(s.name for s in fittable())}")
+
+
+def _list(items) -> str:
+    items = list(items)
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " or " + items[-1]
+
+
+def fittable():
+    from . import all_specs
+    return [s for s in all_specs() if s.standin is not None and s.fit_time is not None]
