@@ -43,19 +43,14 @@ def cloth(n, integrator, dt, **kw):
 
 
 def drape_step(net, seg):
-    """One coupling step against the sphere. Explicit and local/global collide the points;
-    implicit needs segments (their Jacobians), of which only those that can reach the sphere
-    within the step are passed (a point within reach after the step is now within reach +
-    2 |v|max h + 1 cm; both ends farther: skip)."""
+    """One coupling step against the sphere, sub-cycled in the network (its ``subcycle``
+    hook): every integrator collides the points (as (p, p) element pairs)."""
+    from interplay.kernels.contact import colliders
     net.clear_forces()
-    sel = None
-    if net.integrator == "implicit":
-        r = np.linalg.norm(net.x, axis=1)
-        reach = RADIUS + CONTACT[0] + 2.0 * H * float(np.abs(net.v).max()) * np.sqrt(3) + 0.01
-        near = r < reach
-        sel = seg[near[seg[:, 0]] | near[seg[:, 1]]]
-    zero = np.zeros(3)
-    net.add_moving_sphere(sel, zero, zero, zero, zero, RADIUS, 1e9, CONTACT)
+    cols = colliders(1)
+    cols.radii[0], cols.masses[0], cols.law[0] = RADIUS, 1e9, CONTACT
+    n = len(net.x)
+    net.subcycle(cols, np.stack([np.arange(n)] * 2, axis=1))
     net.advance(H)
 
 

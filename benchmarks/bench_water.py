@@ -39,7 +39,7 @@ def bench_pond(repeats, duration):
     return {"grid": list(scene.systems[0].shape), "balls": pond.PondParams().balls.count,
             "duration_s": duration, "wall_s": stats(walls),
             "sim_s_per_wall_s": duration / med, "peak_particles": d["peak_particles"],
-            "volume_drift_rel": d["volume_drift_rel"], "steps": last.passes[0].steps}
+            "volume_drift_rel": d["volume_drift_rel"], "steps": last.passes[0]["steps"]}
 
 
 def _tank(cells):

@@ -1,4 +1,7 @@
-"""Scene parameters as nested frozen dataclasses, and ``--set key=value`` overrides."""
+"""Scene parameters as nested frozen dataclasses, and ``--set key=value`` overrides.
+
+A tuple parameter keeps the length of its default unless its field says otherwise
+(``metadata={"length": None}``: any length, e.g. one value per ball)."""
 from __future__ import annotations
 
 import dataclasses
@@ -6,8 +9,12 @@ import typing
 
 from .errors import ParameterError
 
+#: field metadata of a tuple parameter that may have any length
+ANY_LENGTH = {"length": None}
 
-def _convert(owner_key: str, text, typ):
+
+def _convert(owner_key: str, text, typ, length=None):
+    """``text`` as a value of type ``typ``; a tuple must have ``length`` numbers (None: any)."""
     if not isinstance(text, str):
         return text
     origin = typing.get_origin(typ)
@@ -16,7 +23,7 @@ def _convert(owner_key: str, text, typ):
         if text.strip().lower() in ("none", "auto"):
             return None
         others = [a for a in args if a is not type(None)]
-        return _convert(owner_key, text, others[0])
+        return _convert(owner_key, text, others[0], length)
     try:
         if typ is bool:
             low = text.strip().lower()
@@ -32,7 +39,13 @@ def _convert(owner_key: str, text, typ):
         if typ is str:
             return text
         if origin is tuple or typ is tuple:
-            return tuple(float(v) for v in text.replace("(", "").replace(")", "").split(","))
+            values = tuple(float(v) for v in text.replace("(", "").replace(")", "").split(","))
+            if length is None or len(values) == length:
+                return values
+            raise ParameterError(f"--set {owner_key}={text}: expected {length} numbers, "
+                                 f"got {len(values)}")
+    except ParameterError:
+        raise
     except ValueError:
         pass
     else:
@@ -54,9 +67,10 @@ def keys(params) -> list[str]:
     return out
 
 
-def override(params, key: str, value):
+def override(params, key: str, value, prefix: str = ""):
     """A copy of ``params`` with the dotted ``key`` set to ``value`` (a string is converted to
-    the field's type). Unknown keys raise ParameterError listing the valid ones."""
+    the field's type). Unknown keys raise ParameterError listing the valid ones. prefix: the
+    groups above ``params`` (for messages naming the whole key)."""
     head, _, rest = key.partition(".")
     hints = typing.get_type_hints(type(params))
     names = {f.name for f in dataclasses.fields(params)}
@@ -68,7 +82,7 @@ def override(params, key: str, value):
             raise ParameterError(f"--set {key}: {head} is a group; set one of its fields, "
                                  f"e.g. {keys(params)[0]}")
         try:
-            new = override(current, rest, value)
+            new = override(current, rest, value, f"{prefix}{head}.")
         except ParameterError as e:
             if "unknown parameter" in str(e):
                 raise ParameterError(f"--set {key}: unknown parameter; valid keys: "
@@ -78,7 +92,9 @@ def override(params, key: str, value):
         if rest:
             raise ParameterError(f"--set {key}: unknown parameter; valid keys: "
                                  f"{', '.join(keys(params))}")
-        new = _convert(key, value, hints[head])
+        fld = next(f for f in dataclasses.fields(params) if f.name == head)
+        length = fld.metadata.get("length", len(current) if isinstance(current, tuple) else None)
+        new = _convert(prefix + key, value, hints[head], length)
     return dataclasses.replace(params, **{head: new})
 
 

@@ -16,6 +16,8 @@ the second core gives. Measure on your machine before turning it on.
 import numpy as np
 from numba import njit, prange
 
+from .springs import spring_pull
+
 
 def adjacency(n, si, sj, a_idx):
     """(indptr, spring ids, sign, anchor indptr, anchor ids, scratch): the CSR of point ->
@@ -47,21 +49,8 @@ def explicit_step(net, fext, f, h, nsteps, adj):
     for _ in range(nsteps):
         for s in prange(si.shape[0]):
             # fs[s] (N): the force of spring s on its point si[s] (minus it on sj[s])
-            a = si[s]
-            b = sj[s]
-            d0 = x[a, 0] - x[b, 0]
-            d1 = x[a, 1] - x[b, 1]
-            d2 = x[a, 2] - x[b, 2]
-            l2 = d0 * d0 + d1 * d1 + d2 * d2
-            if l2 <= 0.0 or (tension_only[s] and l2 < l0[s] * l0[s]):
-                fs[s, 0] = 0.0
-                fs[s, 1] = 0.0
-                fs[s, 2] = 0.0
-                continue
-            inv = 1.0 / np.sqrt(l2)
-            vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1
-                  + (v[a, 2] - v[b, 2]) * d2) * inv
-            mag = (-k[s] * (l2 * inv - l0[s]) - kd[s] * vr) * inv
+            _, mag, d0, d1, d2 = spring_pull(x, v, si[s], sj[s], l0[s], k[s], kd[s],
+                                             tension_only[s])
             fs[s, 0] = mag * d0
             fs[s, 1] = mag * d1
             fs[s, 2] = mag * d2

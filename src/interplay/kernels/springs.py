@@ -102,6 +102,23 @@ def _spring_vector(x, a, b):
     return d0, d1, d2, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
+@njit(cache=True, inline="always")
+def spring_pull(x, v, a, b, rest, k, kd, tension_only):
+    """(pulls, mag, d0, d1, d2): the force of spring a-b (rest length m, stiffness N/m,
+    along-spring damping N s/m) on point a is mag * (d0, d1, d2) = mag * (x_a - x_b), minus it
+    on b; pulls is False for a slack cord or a zero-length spring (no force)."""
+    d0 = x[a, 0] - x[b, 0]
+    d1 = x[a, 1] - x[b, 1]
+    d2 = x[a, 2] - x[b, 2]
+    l2 = d0 * d0 + d1 * d1 + d2 * d2
+    # slack cords are skipped on the squared length: no square root for them
+    if l2 <= 0.0 or (tension_only and l2 < rest * rest):
+        return False, 0.0, d0, d1, d2
+    inv = 1.0 / np.sqrt(l2)
+    vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1 + (v[a, 2] - v[b, 2]) * d2) * inv
+    return True, (-k * (l2 * inv - rest) - kd * vr) * inv, d0, d1, d2  # times d = times u l
+
+
 @njit(cache=True)
 def network_forces(net, fext, f):
     """Total force (N) on each point: springs, anchors, Rayleigh mass damping, gravity, external."""
@@ -116,17 +133,9 @@ def network_forces(net, fext, f):
     for s in range(si.shape[0]):
         a = si[s]
         b = sj[s]
-        d0 = x[a, 0] - x[b, 0]
-        d1 = x[a, 1] - x[b, 1]
-        d2 = x[a, 2] - x[b, 2]
-        l2 = d0 * d0 + d1 * d1 + d2 * d2
-        # slack cords are skipped on the squared length: no square root for them
-        if l2 <= 0.0 or (tension_only[s] and l2 < l0[s] * l0[s]):
+        pulls, mag, d0, d1, d2 = spring_pull(x, v, a, b, l0[s], k[s], kd[s], tension_only[s])
+        if not pulls:
             continue
-        inv = 1.0 / np.sqrt(l2)
-        vr = ((v[a, 0] - v[b, 0]) * d0 + (v[a, 1] - v[b, 1]) * d1
-              + (v[a, 2] - v[b, 2]) * d2) * inv
-        mag = (-k[s] * (l2 * inv - l0[s]) - kd[s] * vr) * inv  # times d = times u * length
         f[a, 0] += mag * d0
         f[a, 1] += mag * d1
         f[a, 2] += mag * d2

@@ -12,6 +12,7 @@ from ..interactions.aero import AeroParams, Aerodynamics
 from ..scene import Scene
 from ..systems.colliders import StaticMesh
 from ..systems.springmass import SpringNetwork
+from ..systems.static import StaticPlane
 from ..systems.wind import FlowPrimitive, WindField
 from .contract import SceneSpec
 
@@ -95,8 +96,9 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
           params: FlagsParams = FlagsParams()) -> Scene:
     """The scene; integrator and dt (s) override every flag's. The wind ignores forces: the
     coupling is one-way (the air does not feel the cloth). The poles are set pieces (static
-    meshes: drawn, costing no pass)."""
+    meshes: drawn, costing no pass), standing on the ground."""
     scene = Scene("flags", duration=duration, fps=fps)
+    scene.add(StaticPlane("ground", height=0.0, size=8.0))
     wind = scene.add(wind_field(params.wind))
     for name in ("cotton", "nylon", "canvas"):
         p = getattr(params, name)

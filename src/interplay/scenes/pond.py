@@ -6,13 +6,14 @@ still-water stand-in (buoyancy and drag below a flat surface) and then drives th
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..errors import ParameterError
 from ..geometry.basin import BasinParams, basin
 from ..interactions.buoyancy import BodyInWater, BuoyancyParams
 from ..interactions.contact import ContactParams, SpherePlaneContact
 from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
+from ..params import ANY_LENGTH
 from ..scene import Scene
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
@@ -26,11 +27,11 @@ class BallsParams:
     x and y of the drop (m), drop height of the ball's bottom above the still surface (m).
     dt: the balls' step (s)."""
     count: int = 5
-    radius: tuple = (0.07, 0.06, 0.05, 0.065, 0.055)
-    density: tuple = (500.0, 300.0, 700.0, 850.0, 2500.0)
-    x: tuple = (-0.35, 0.3, -0.2, 0.35, 0.0)
-    y: tuple = (0.25, 0.3, -0.35, -0.2, 0.0)
-    height: tuple = (0.25, 0.4, 0.15, 0.3, 0.5)
+    radius: tuple = field(default=(0.07, 0.06, 0.05, 0.065, 0.055), metadata=ANY_LENGTH)
+    density: tuple = field(default=(500.0, 300.0, 700.0, 850.0, 2500.0), metadata=ANY_LENGTH)
+    x: tuple = field(default=(-0.35, 0.3, -0.2, 0.35, 0.0), metadata=ANY_LENGTH)
+    y: tuple = field(default=(0.25, 0.3, -0.35, -0.2, 0.0), metadata=ANY_LENGTH)
+    height: tuple = field(default=(0.25, 0.4, 0.15, 0.3, 0.5), metadata=ANY_LENGTH)
     dt: float = 1e-3  # s
 
 

@@ -10,13 +10,14 @@ resolved). Without the clip the foot follows the keyframed running step of FootP
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..geometry.basin import BasinParams, basin
 from ..interactions.buoyancy import BodyInWater, BuoyancyParams
 from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
+from ..params import ANY_LENGTH
 from ..scene import Scene
 from ..systems.kinematic import KeyframedBody, KeyframedBodyParams
 from ..systems.mocap import MocapFigure, clip_path
@@ -29,13 +30,13 @@ class FootParams(KeyframedBodyParams):
     """A running step: the foot swings in at about 2 m/s down and forward, lands flat on the
     bed (centre one semi-axis above it), rolls forward 3 cm in 0.2 s of stance and pushes off.
     times in s, positions m (x, y, z per key)."""
-    times: tuple = (0.0, 0.12, 0.2, 0.4, 0.52, 0.75)
-    positions: tuple = (-0.55, 0.0, 0.28,
-                        -0.2, 0.0, 0.15,
-                        -0.06, 0.0, 0.045,
-                        -0.03, 0.0, 0.045,
-                        0.12, 0.0, 0.14,
-                        0.55, 0.0, 0.3)
+    times: tuple = field(default=(0.0, 0.12, 0.2, 0.4, 0.52, 0.75), metadata=ANY_LENGTH)
+    positions: tuple = field(default=(-0.55, 0.0, 0.28,
+                                      -0.2, 0.0, 0.15,
+                                      -0.06, 0.0, 0.045,
+                                      -0.03, 0.0, 0.045,
+                                      0.12, 0.0, 0.14,
+                                      0.55, 0.0, 0.3), metadata=ANY_LENGTH)
     semi_axes: tuple = (0.13, 0.05, 0.045)  # m: a shoe 26 cm long, 10 cm wide
     mass: float = 1.2  # kg: foot and shank
     dt: float = 0.002  # s

@@ -3,11 +3,12 @@ forces. Nothing pushes back on them, so they are primaries of one-way interactio
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ParameterError, require_positive
+from ..params import ANY_LENGTH
 from ..geometry.primitive import Primitive
 from ..geometry.sphere import icosphere
 from .base import Role, System
@@ -21,8 +22,8 @@ class KeyframedBodyParams:
     semi_axes (m) of its ellipsoid shape in the body frame (x forward); yaw (rad) about +z;
     mass (kg: what the analysis divides interaction forces by); dt (s): its step (any step is
     exact: the path is a function of time)."""
-    times: tuple = (0.0, 1.0)
-    positions: tuple = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+    times: tuple = field(default=(0.0, 1.0), metadata=ANY_LENGTH)
+    positions: tuple = field(default=(0.0, 0.0, 0.0, 1.0, 0.0, 0.0), metadata=ANY_LENGTH)
     semi_axes: tuple = (0.13, 0.05, 0.045)  # m
     yaw: float = 0.0  # rad
     mass: float = 1.1  # kg

@@ -25,7 +25,22 @@ import numpy as np
 
 
 
-class PointsView:
+class _View:
+    """What every view shares: the system it shows, its name and its time (s)."""
+
+    def __init__(self, system):
+        self.system = system
+
+    @property
+    def name(self) -> str:
+        return self.system.name
+
+    @property
+    def time(self) -> float:
+        return self.system.time
+
+
+class PointsView(_View):
     """Point masses. Live arrays: ``x``, ``v`` (n,3); ``inverse_mass`` (n,) 1/kg (0 for fixed
     points); ``masses`` (n,). Topology: ``triangles`` (m,3) or None, ``segments`` (s,2) (the
     springs: what cords collide as). ``thickness`` (m): the elements' skin (a cord's radius).
@@ -36,21 +51,13 @@ class PointsView:
 
     def __init__(self, system, points, triangles=None, segments=None, thickness=0.0,
                  jacobians=False):
-        self.system = system
+        super().__init__(system)
         self.points = points
         self.x, self.v, self.masses = points.x, points.v, points.m
         self.triangles = triangles
         self.segments = segments
         self.thickness = float(thickness)
         self.jacobians = bool(jacobians)
-
-    @property
-    def name(self) -> str:
-        return self.system.name
-
-    @property
-    def time(self) -> float:
-        return self.system.time
 
     @property
     def inverse_mass(self) -> np.ndarray:
@@ -122,7 +129,7 @@ class RigidParts(ABC):
         cannot be pushed ignore it."""
 
 
-class BodiesView:
+class BodiesView(_View):
     """Rigid parts. ``names`` (k,); ``meshes`` [(vertices (v,3), triangles (t,3))] in each
     part's frame; ``primitives`` [Primitive or None]; ``masses`` (k,) kg (inf when the system
     cannot be pushed); ``movable``: whether forces move it (a dynamic system). The system
@@ -131,7 +138,7 @@ class BodiesView:
     kind = "bodies"
 
     def __init__(self, system, names, meshes, primitives, masses, movable):
-        self.system = system
+        super().__init__(system)
         self.names = list(names)
         self.meshes = meshes
         self.primitives = primitives
@@ -141,14 +148,6 @@ class BodiesView:
         # m, from each part's frame origin: bounds every vertex of its mesh
         self.reach = np.array([float(np.linalg.norm(v, axis=1).max()) if len(v) else 0.0
                                for v, _ in meshes])
-
-    @property
-    def name(self) -> str:
-        return self.system.name
-
-    @property
-    def time(self) -> float:
-        return self.system.time
 
     def part(self, name: str) -> int:
         """Index of the part called ``name``."""
@@ -191,7 +190,7 @@ class BodiesView:
             self.system.add_part_wrench(part, force, torque, point, dfdx, dfdv)
 
 
-class ShapeView:
+class ShapeView(_View):
     """An immovable analytic shape: ``distance(points) -> (s (n,), normals (n,3))``, the signed
     distance (m, negative inside) and the outward normal; ``depth`` (m or None): how far behind
     its surface a point still counts as inside (a one-sided mesh); ``height`` for a plane z =
@@ -201,10 +200,6 @@ class ShapeView:
     movable = False
 
     def __init__(self, system, distance, height=None):
-        self.system = system
+        super().__init__(system)
         self.distance = distance
         self.height = height
-
-    @property
-    def name(self) -> str:
-        return self.system.name
