@@ -47,7 +47,8 @@ def test_every_builder_parameter_is_settable():
     p = P.apply(small(), {"wind.speed": "0", "wind.cross": "0", "cotton.integrator": "explicit",
                           "cotton.dt": "2e-4"})
     scene = flags.build(duration=0.05, params=p)
-    assert scene.systems[1].integrator == "explicit"
+    systems = {s.name: s for s in scene.systems}
+    assert systems["cotton"].integrator == "explicit"
 
 
 def test_hybrid_is_refused():
