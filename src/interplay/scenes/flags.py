@@ -9,6 +9,7 @@ import numpy as np
 
 from ..geometry import shapes
 from ..interactions.aero import AeroParams, Aerodynamics
+from ..outputs.render.camera import Camera
 from ..scene import Scene
 from ..systems.colliders import StaticMesh
 from ..systems.springmass import SpringNetwork
@@ -69,6 +70,11 @@ class FlagsParams:
                                     shear=150.0, bend=3.0)
 
 
+# linear RGB: cream cotton, red nylon, navy canvas (apart from each other and from the sky)
+COLORS = {"cotton": (0.85, 0.82, 0.70), "nylon": (0.75, 0.06, 0.05),
+          "canvas": (0.06, 0.12, 0.30)}
+
+
 def wind_field(w: GustyWind) -> WindField:
     h = math.radians(w.heading)
     along, across = (math.cos(h), math.sin(h), 0.0), (-math.sin(h), math.cos(h), 0.0)
@@ -98,7 +104,7 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
     coupling is one-way (the air does not feel the cloth). The poles are set pieces (static
     meshes: drawn, costing no pass), standing on the ground."""
     scene = Scene("flags", duration=duration, fps=fps)
-    scene.add(StaticPlane("ground", height=0.0, size=8.0))
+    scene.add(StaticPlane("ground", height=0.0, size=12.0, color=(0.30, 0.42, 0.20)))
     wind = scene.add(wind_field(params.wind))
     for name in ("cotton", "nylon", "canvas"):
         p = getattr(params, name)
@@ -107,8 +113,10 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
         if dt is not None:
             p = replace(p, dt=dt)
         cloth = scene.add(flag(name, p))
+        cloth.color = COLORS[name]
         pv, pt = shapes.pole(p.pole_height + 0.1)
-        scene.add(StaticMesh(f"{name}-pole", pv + np.asarray(p.pole, float), pt))
+        scene.add(StaticMesh(f"{name}-pole", pv + np.asarray(p.pole, float), pt,
+                             color=(0.78, 0.78, 0.80), material="metal"))
         scene.connect(Aerodynamics(f"wind-{name}", wind, cloth, params.aero, mode="one-way"))
     scene.primary = wind
     return scene
@@ -117,4 +125,6 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
 SPEC = SceneSpec(
     "flags", "flags of cotton, nylon and canvas on poles in a gusty wind (one-way)", build,
     FlagsParams, couplings=("one-way",), duration=4.0, fps=60.0,
-    integrators=("explicit", "implicit", "localglobal"))
+    integrators=("explicit", "implicit", "localglobal"),
+    # downwind and to the side, the small nylon flag nearest: all three fill the frame
+    camera=Camera((4.6, 7.4, 2.3), (0.9, -0.4, 2.75), 42.0))

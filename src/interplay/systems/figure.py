@@ -24,7 +24,7 @@ from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, joint_nam
                                       segment_mesh, segment_primitive)
 from .base import System, substeps
 from .figure_model import AirDrag, EnvironmentParams, build_model, geom_extents, joint_group
-from .shape import Shape
+from .shape import figure_shape
 from .views import BodiesView, RigidParts
 
 LEG_GROUPS = ("hip", "knee", "ankle", "toe")
@@ -483,9 +483,7 @@ class Figure(System, RigidParts):
         self.add_wrench(force, torque, point, body=int(part))
 
     def shapes(self):
-        return [Shape(self.name, "parts", color=self.color,
-                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
-                             for v, t in self.segment_meshes()])]
+        return [figure_shape(self.name, self.plan, self.color)]
 
     # --- geometry ----------------------------------------------------------------------------
     def segment_meshes(self) -> list:

@@ -21,7 +21,7 @@ from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, segment_m
 from ..io.motion_file import BVHError, Motion, read_bvh
 from ..kernels.rigid import quat_mul
 from .base import Role, System
-from .shape import Shape
+from .shape import figure_shape
 from .views import BodiesView, RigidParts
 
 # segment -> (candidate joint names, candidate names of the joint ending its bone)
@@ -73,16 +73,41 @@ def _quats(R) -> np.ndarray:
     return np.roll(q, 1, axis=-1).reshape(R.shape[:-2] + (4,))
 
 
+TPOSE_JUMP = 5.0  # deg (RMS over the joints): a first frame this far from the second ...
+TPOSE_RATIO = 5.0  # ... and this many times the next frame-to-frame changes is no motion
+STANCE_SPEED = 0.6  # m/s: a sole slower than this, near its lowest, is standing
+STANCE_RISE = 0.02  # m: ... within this of the lowest point it reaches around then
+
+
+def tpose_first(motion: Motion) -> bool:
+    """Whether frame 0 is a calibration pose (the T-pose the CMU conversions put first) rather
+    than motion: its joint rotations jump to frame 1 by more than TPOSE_JUMP degrees (root
+    mean square over the rotation channels) and by TPOSE_RATIO times the largest such change
+    over the next ten frames. (The clips here: 28, 31 and 16 deg against at most 2.4, 0.05
+    and 0.1 for the three with a T-pose; 0.8 against 0.9 for the two without.)"""
+    f = motion.frames
+    if len(f) < 4:
+        return False
+    rot = [j.first + c for j in motion.joints for c, ch in enumerate(j.channels)
+           if ch.endswith("rotation")]
+    change = np.abs(np.diff(f[: min(len(f), 12), rot], axis=0))
+    change = np.sqrt(np.mean(np.minimum(change, 360.0 - change) ** 2, axis=1))  # deg
+    return bool(change[0] > TPOSE_JUMP and change[0] > TPOSE_RATIO * change[1:].max())
+
+
 class MocapFigure(System, RigidParts):
     """A figure that plays a retargeted BVH clip. mass (kg) is what the analysis divides
     interaction forces by; units: one of UNITS or None to detect; skip_tpose: drop a first
-    frame whose rotations are all zero (the T-pose the cgspeed conversion adds)."""
+    frame that is a calibration pose, not motion (``tpose_first``: the CMU clips have one);
+    position_offset (m): where the clip is placed; ground: None, a height (m) or a function
+    height(x, y) -> z (m) of the terrain: the clip is then lifted or lowered, stance by stance,
+    so that each standing foot's sole rests on it (``plant``), easing between stances."""
 
     role = Role.PRESCRIBED
     integrator = "retargeted BVH clip, cubic spline playback"
 
     def __init__(self, name: str, path, mass: float = 75.0, units: str | None = None,
-                 skip_tpose: bool = True, position_offset=(0.0, 0.0, 0.0)):
+                 skip_tpose: bool = True, position_offset=(0.0, 0.0, 0.0), ground=None):
         motion = read_bvh(path)
         super().__init__(name, motion.frame_time)
         if units is not None and units not in UNITS:
@@ -100,12 +125,9 @@ class MocapFigure(System, RigidParts):
         scale = UNITS[units] if units else min(
             UNITS.values(), key=lambda u: abs(np.log(sum(legs) * u / TYPICAL_LEG)))
         self.units = units or next(k for k, v in UNITS.items() if v == scale)
-        frames = motion.frames
-        if skip_tpose and len(frames) > 1:
-            rot_cols = [j.first + c for j in motion.joints for c, ch in enumerate(j.channels)
-                        if ch.endswith("rotation")]
-            if np.all(frames[0, rot_cols] == 0.0):
-                motion.frames = frames[1:]
+        self.skipped_tpose = bool(skip_tpose and tpose_first(motion))
+        if self.skipped_tpose:
+            motion.frames = motion.frames[1:]
         hip = (rest[idx["l_thigh"]] - rest[idx["pelvis"]]) * scale @ C.T
         H = (legs[0] + legs[1]) * scale / 0.491  # thigh + shank = 0.491 of standing height
         self.body = BodyParams(mass=mass, height=float(np.clip(H, 0.5, 3.0)),
@@ -134,6 +156,10 @@ class MocapFigure(System, RigidParts):
             else:
                 p = SEGMENTS.index(seg.parent)
                 seg_pos[:, k] = seg_pos[:, p] + seg_rot[:, p] @ seg.offset
+        self.plant_offsets = np.zeros(F)
+        if ground is not None:
+            self.plant_offsets = self.plant(seg_pos, seg_rot, motion.frame_time, ground)
+            seg_pos[:, :, 2] += self.plant_offsets[:, None]
         q = _quats(seg_rot)
         # sign continuity so the spline does not cross the quaternion double cover
         for f in range(1, F):
@@ -153,6 +179,53 @@ class MocapFigure(System, RigidParts):
         self._middle = np.array([pr.middle for pr in prims])  # m, segment frame
         self._view = BodiesView(self, SEGMENTS, self.segment_meshes(), prims,
                                 np.full(17, np.inf), movable=False)
+
+    def soles(self, seg_pos, seg_rot) -> np.ndarray:
+        """(F, 2) height (m) of the lowest point of the left and the right foot (foot and toes
+        segments) in each frame."""
+        out = np.empty((len(seg_pos), 2))
+        for side, pair in enumerate((("l_foot", "l_toes"), ("r_foot", "r_toes"))):
+            low = []
+            for name in pair:
+                k = SEGMENTS.index(name)
+                v = segment_mesh(self.plan[k].shape)[0]
+                low.append((seg_pos[:, k, 2, None]
+                            + np.einsum("fj,nj->fn", seg_rot[:, k, 2], v)).min(axis=1))
+            out[:, side] = np.minimum(*low)
+        return out
+
+    def plant(self, seg_pos, seg_rot, dt: float, ground) -> np.ndarray:
+        """(F,) vertical offset (m) per frame that puts every stance's sole on the ground:
+        constant through each stance (frames where a sole is slower than STANCE_SPEED within
+        STANCE_RISE of its lowest nearby point), monotone cubic between stances."""
+        from scipy.interpolate import PchipInterpolator
+        from scipy.ndimage import minimum_filter1d
+        height = ground if callable(ground) else (lambda x, y, g=float(ground): g)
+        sole = self.soles(seg_pos, seg_rot)
+        F = len(sole)
+        knots_t, knots_v = [], []
+        for side, name in enumerate(("l_foot", "r_foot")):
+            k = SEGMENTS.index(name)
+            speed = np.linalg.norm(np.gradient(seg_pos[:, k], dt, axis=0), axis=1)
+            near = minimum_filter1d(sole[:, side], size=max(3, int(0.3 / dt)), mode="nearest")
+            standing = (speed < STANCE_SPEED) & (sole[:, side] < near + STANCE_RISE)
+            edges = np.flatnonzero(np.diff(np.r_[0, standing.astype(int), 0]))
+            for a, b in zip(edges[::2], edges[1::2]):  # frames a .. b-1 stand
+                if b - a < 3:
+                    continue
+                x, y = seg_pos[a:b, k, :2].mean(axis=0)
+                lift = float(height(x, y)) - float(sole[a:b, side].min())
+                knots_t += [a, b - 1]
+                knots_v += [lift, lift]
+        if not knots_t:
+            return np.zeros(F)
+        order = np.argsort(knots_t, kind="stable")
+        t, v = np.asarray(knots_t, float)[order], np.asarray(knots_v)[order]
+        keep = np.r_[True, np.diff(t) > 0]  # a stance ending where the next starts: one knot
+        t, v = t[keep], v[keep]
+        if len(t) == 1:
+            return np.full(F, v[0])
+        return PchipInterpolator(t, v, extrapolate=False)(np.clip(np.arange(F), t[0], t[-1]))
 
     @staticmethod
     def _rest_positions(motion: Motion) -> np.ndarray:
@@ -267,11 +340,15 @@ class MocapFigure(System, RigidParts):
         return (m[:, None] * self.part_centres()).sum(axis=0) / m.sum()
 
     def shapes(self):
-        return [Shape(self.name, "parts", color=self.color,
-                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
-                             for v, t in self.segment_meshes()])]
+        return [figure_shape(self.name, self.plan, self.color)]
 
 
 def clip_path(name: str) -> Path:
-    """A clip in the shared mocap data folder (../shared/data/mocap next to the repository)."""
-    return Path(__file__).resolve().parents[3] / ".." / "shared" / "data" / "mocap" / name
+    """A clip in the shared mocap data folder: shared/data/mocap beside the repository or
+    beside any folder above it (a worktree's repository sits deeper)."""
+    repo = Path(__file__).resolve().parents[3]
+    for base in (repo, *repo.parents):
+        folder = base / "shared" / "data" / "mocap"
+        if folder.is_dir():
+            return folder / name
+    return repo.parent / "shared" / "data" / "mocap" / name

@@ -24,6 +24,12 @@ from .shape import Shape
 #: up to 1.0 for the fastest 8-pipe mode; 0.7 leaves room for depth growing within a step)
 STABLE_CFL = 0.7
 
+# linear RGB as drawn: clear water over a muddy sand bed; spray as white foam droplets
+WATER_COLOR = (0.06, 0.25, 0.30)
+SPRAY_COLOR = (0.92, 0.96, 1.0)
+BED_COLOR = (0.45, 0.37, 0.25)
+BANK_COLOR = (0.30, 0.42, 0.20)  # the grass the bed rises into above the water
+
 
 @dataclass(frozen=True)
 class SprayParams:
@@ -163,7 +169,9 @@ class Water(System):
                                     float(s.fraction), self.particle_volume, float(s.radius),
                                     self.air_drag)
         self._scratch = K.Scratch(np.zeros(bed.shape), np.zeros(bed.shape), np.zeros(bed.shape))
-        self.color = None
+        # linear RGB as drawn: the water (None: WATER_COLOR), its bed below the still water and
+        # the bed where it rises above it (the banks)
+        self.color, self.bed_color, self.bank_color = None, BED_COLOR, BANK_COLOR
 
     # --- the System protocol -----------------------------------------------------------------
     @property
@@ -234,14 +242,32 @@ class Water(System):
         return verts, tris
 
     def shapes(self):
-        """The surface (a height field over the columns) and its spray."""
+        """The surface (a height field over the columns: translucent water, its bed heights
+        tell wet columns from dry), its spray (bright droplets) and the bed under it (the
+        basin's floor and walls, a static mesh over every column)."""
         _, tris = self.surface()
         X, Y = self.column_centres()
-        out = [Shape(self.name, "surface", color=self.color, triangles=np.asarray(tris, np.int64),
-                     grid_xy=np.stack([X.ravel(), Y.ravel()], axis=1))]
+        xy = np.stack([X.ravel(), Y.ravel()], axis=1)
+        out = [Shape(self.name, "surface", color=self.color or WATER_COLOR,
+                     triangles=np.asarray(tris, np.int64), grid_xy=xy,
+                     base=self.bed.ravel().copy(), material="water")]
         if self.spray_on:
-            out.append(Shape(f"{self.name}-spray", "particles", color=self.color,
-                             width=2.0 * self.params.spray.radius, source=(self.name, "particles")))
+            out.append(Shape(f"{self.name}-spray", "particles", color=SPRAY_COLOR,
+                             width=2.0 * self.params.spray.radius, source=(self.name, "particles"),
+                             material="spray"))
+        nx, ny = self.shape
+        idx = np.arange(nx * ny).reshape(nx, ny)
+        a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+        c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+        # sand below the highest still water, grass on the banks above it
+        wet = self.fluid & (self.V > 0.0)
+        level = float(np.max(np.where(wet, self.bed + self.V / self.area, -np.inf)))
+        up = np.clip((self.bed.ravel() - level) / 0.03, 0.0, 1.0)[:, None]
+        colors = (1 - up) * np.asarray(self.bed_color) + up * np.asarray(self.bank_color)
+        out.append(Shape(f"{self.name}-bed", "static", color=self.bed_color,
+                         verts=np.concatenate([xy, self.bed.reshape(-1, 1)], axis=1),
+                         tris=np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]),
+                         palette="static", material="ground", point_colors=colors))
         return out
 
     def frame(self):
