@@ -41,6 +41,8 @@ def _output_options(p):
     g.add_argument("--size", default="1280x720", metavar="WxH", help="video size in pixels")
     g.add_argument("--video-fps", type=float, default=30.0, help="video frames per second")
     g.add_argument("--usda", action="store_true", help="write text .usda instead of .usdc")
+    g.add_argument("--obj", action="store_true",
+                   help="also write OBJ sequences (a file per frame per system; off by default)")
     for name in ("usd", "obj", "video", "report"):
         g.add_argument(f"--no-{name}", action="store_true", help=f"skip the {name} output")
 
@@ -58,7 +60,8 @@ def _outputs(args, spec=None):
     if not 1.0 <= args.video_fps <= 240.0:
         raise ParameterError(f"--video-fps {args.video_fps:g}: choose 1 to 240 frames/s")
     return OutputOptions(usd=not args.no_usd, usd_format="usda" if args.usda else "usdc",
-                         obj=not args.no_obj, video=not args.no_video, report=not args.no_report,
+                         obj=args.obj and not args.no_obj, video=not args.no_video,
+                         report=not args.no_report,
                          size=size, video_fps=args.video_fps,
                          camera=(parse_camera(args.camera) if args.camera
                                  else spec.camera if spec is not None else None),

@@ -49,6 +49,24 @@ class Path:
         return self.position(t), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+class Prop:
+    """A rig of one rigid part: vertices (n,3) m and triangles (m,3) in the frame of travel
+    (x forward, z up), that a PathFollower carries unchanged. color: linear RGB."""
+
+    PART_NAMES = ("body",)
+    PARENTS = (-1,)
+
+    def __init__(self, vertices, triangles, color=(0.55, 0.55, 0.57)):
+        self.parts = [(np.asarray(vertices, float), np.asarray(triangles, np.int64))]
+        self.COLORS = (tuple(color),)
+
+    def pose(self, s: float):
+        return np.zeros((1, 3)), np.eye(3)[None]
+
+    def mesh(self):
+        return self.parts[0]
+
+
 class PathFollower(System, RigidParts):
     """A rig of rigid parts carried along a ``Path`` (x forward along the direction of travel).
 

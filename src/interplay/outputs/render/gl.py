@@ -15,17 +15,17 @@ import math
 import numpy as np
 
 from ...errors import InterplayError
-from ...systems.shape import DRY, MATERIALS
+from ...systems.shape import MATERIALS
+from ..geometry import vertex_normals, wet_surface
 from . import shaders
 from .camera import Camera, TrackingCamera, cameras, default_camera
 
 ZENITH = np.array([0.30, 0.45, 0.72])   # linear RGB of the sky overhead
 HORIZON = np.array([0.78, 0.82, 0.86])  # ... and at the horizon
+HAZE = np.array([0.66, 0.69, 0.72])     # below the horizon: the backdrop fog fades into
 SUN = np.array([0.30, -0.50, 1.0]) / np.linalg.norm([0.30, -0.50, 1.0])  # towards the sun
 HOOK_COLOR = (0.12, 0.12, 0.13)
 PENUMBRA = 0.02  # m, width of the soft shadow edge
-WATER_LOWER = 4e-3  # m: a dry column's water surface is drawn this far under its bed
-WATER_DEPTH = 0.08  # m: water this deep lets through 1/e of the light from its bed
 THIN = 0.45  # share of the sun a sunlit cloth or leaf shows on its shaded side
 GL_HINT = ("install the Mesa EGL driver (`make` does it, or apt-get install -y libegl1 "
            "libegl-mesa0 libgl1-mesa-dri) or skip the video with --no-video")
@@ -51,17 +51,6 @@ def gl_context():
     return _CTX
 
 
-def fast_normals(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
-    """Area-weighted unit vertex normals (n,3), float32 (bincount: no Python loop)."""
-    p = np.asarray(points, dtype=np.float64)
-    fn = np.cross(p[tris[:, 1]] - p[tris[:, 0]], p[tris[:, 2]] - p[tris[:, 0]])
-    idx = tris.reshape(-1)
-    n = np.stack([np.bincount(idx, np.repeat(fn[:, k], 3), minlength=len(p))
-                  for k in range(3)], axis=1)
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    return (n / np.where(length > 0, length, 1.0)).astype(np.float32)
-
-
 def quat_matrix4(pos, q) -> np.ndarray:
     w, x, y, z = q
     m = np.eye(4)
@@ -83,21 +72,7 @@ def floor_extent(shape):
     return float(v[:, 0].min()), float(v[:, 0].max()), float(v[:, 1].min()), float(v[:, 1].max())
 
 
-def wet_surface(shape, points):
-    """A height field's drawn points (n,3) (dry columns just under their bed, so the bed's
-    depth test cuts a smooth waterline), per-point opacity (n,) (shallow water shows its bed)
-    and the triangles with at least one wet corner (the others are not drawn)."""
-    depth = points[:, 2] - shape.base
-    wet = depth > DRY
-    p = points.copy()
-    p[~wet, 2] = shape.base[~wet] - WATER_LOWER
-    alpha = shape.look.opacity * (1.0 - np.exp(-np.maximum(depth, 0.0) / WATER_DEPTH))
-    alpha = np.clip(alpha, 0.12, 0.92)
-    tris = shape.triangles[wet[shape.triangles].any(axis=1)]
-    return p, alpha, tris
-
-
-def _unit_cylinder(sides=8):
+def _unit_cylinder(sides=6):
     a = 2 * np.pi * np.arange(sides) / sides
     ring = np.stack([np.cos(a), np.sin(a), np.zeros(sides)], axis=1)
     pos = np.concatenate([ring, ring + [0, 0, 1]])
@@ -167,14 +142,17 @@ class Renderer:
                       for k, vs in (("mesh", shaders.MESH_VS), ("tube", shaders.TUBE_VS),
                                     ("ball", shaders.BALL_VS))}
         self.sky = ctx.program(vertex_shader=shaders.SKY_VS, fragment_shader=shaders.SKY_FS)
+        self.points = ctx.program(vertex_shader=shaders.POINT_VS,
+                                  fragment_shader=shaders.POINT_FS)
         self.sky_vao = ctx.vertex_array(self.sky, [])
         self.shapes = list(run.shapes)  # only what the scene has: no invented floor
         self.uniforms = {"u_light_dir": tuple(SUN), "u_zenith": tuple(ZENITH),
-                         "u_horizon": tuple(HORIZON)}
+                         "u_horizon": tuple(HORIZON), "u_haze": tuple(HAZE)}
         self._objects = []
         self._resources = [self.fbo, self.resolve, self.shadow_tex, self.shadow_fbo,
-                           *self.progs.values(), *self.depth.values(), self.sky, self.sky_vao]
-        # cords and knots are a few pixels wide: eight-sided tubes and icosahedra look round
+                           *self.progs.values(), *self.depth.values(), self.sky, self.sky_vao,
+                           self.points]
+        # cords and knots are a few pixels wide: six-sided tubes and icosahedra look round
         # there and keep the vertex work small (llvmpipe); hooks and particles get more
         cyl, self._knot_sphere, sph = _unit_cylinder(), _unit_sphere(0), _unit_sphere(1)
         for shape in self.shapes:
@@ -208,6 +186,7 @@ class Renderer:
         near = max(0.02, 0.05 * dist)
         far = max(reach, dist) + 200.0
         self.vp = cam.projection(self.w / self.h, near, far) @ cam.view()
+        self.px_per_m = self.h / (2.0 * math.tan(math.radians(cam.fov_deg) / 2))
         self.uniforms.update({"u_eye": tuple(map(float, cam.eye)),
                               "u_fog": (dist * 3.0 + 30.0, dist * 3.0 + 150.0)})
 
@@ -259,7 +238,7 @@ class Renderer:
         return out
 
     def _mesh(self, shape, verts, tris, rgba, **extra):
-        vbo = self._buffer(np.concatenate([verts, fast_normals(verts, tris), rgba], axis=1))
+        vbo = self._buffer(np.concatenate([verts, vertex_normals(verts, tris), rgba], axis=1))
         vao, dvao = self._vaos("mesh", vbo, self._index(tris))
         ob = {"shape": shape, "kind": "mesh", "vao": vao, "dvao": dvao, "look": shape.look,
               "casts": True, **extra}
@@ -271,7 +250,7 @@ class Renderer:
         if shape.form == "static":
             extent = floor_extent(shape)
             ob = self._mesh(shape, shape.verts, shape.tris, _rgba(shape, len(shape.verts)),
-                            casts=extent is None)
+                            casts=extent is None, centre=shape.verts.mean(axis=0))
             if extent is not None:
                 ob.update(checker=shape.material != "concrete", floor=extent)
         elif shape.form == "body":
@@ -303,7 +282,13 @@ class Renderer:
                                   "count": len(shape.segments), "look": shape.look})
             self._knots(shape, run, self._knot_sphere, color, r)
         elif shape.form == "particles":
-            self._knots(shape, run, sph, color, max(shape.width / 2, 1e-3))
+            n = len(run.frames[shape.name]["points"][0])
+            inst = self._buffer(np.zeros((n, 3)), dynamic=True)
+            vao = self.ctx.vertex_array(self.points, [(inst, "3f", "in_center")])
+            self._resources.append(vao)
+            self._objects.append({"shape": shape, "kind": "points", "vao": vao, "inst": inst,
+                                  "color": color, "radius": max(shape.width / 2, 5e-4),
+                                  "casts": False, "count": 0, "look": shape.look})
         if shape.anchors is not None:
             vbo = self._buffer(np.concatenate(sph[:2], axis=1))
             ibo = self._index(sph[2])
@@ -346,19 +331,20 @@ class Renderer:
             elif ob["kind"] == "surface":
                 p, rgba, tris = st["points"], ob["rgba"], shape.triangles
                 if ob["water"]:
-                    p, alpha, tris = wet_surface(shape, p)
+                    p, alpha, wet = wet_surface(shape, p)
+                    tris = tris[wet]
                     rgba = rgba.copy()
                     rgba[:, 3] = alpha
                     ob["ibo"].write(np.ascontiguousarray(tris, np.int32).tobytes())
                 ob["count"] = len(tris)
                 ob["vbo"].write(np.concatenate([p.astype(np.float32),
-                                                fast_normals(p, shape.triangles), rgba],
+                                                vertex_normals(p, shape.triangles), rgba],
                                                1).tobytes())
             elif ob["kind"] == "cords":
                 p = st["points"].astype(np.float32)
                 seg = shape.segments
                 ob["inst"].write(np.concatenate([p[seg[:, 0]], p[seg[:, 1]]], 1).tobytes())
-            elif ob["kind"] == "knots":
+            elif ob["kind"] in ("knots", "points"):
                 p = st["points"]
                 p = p[np.isfinite(p).all(axis=1)]  # absent particles (spray) are NaN rows
                 ob["count"] = len(p)
@@ -376,9 +362,24 @@ class Renderer:
         else:
             self._fit_sun(self.lo, self.hi)
 
+    def _order(self):
+        """The objects nearest first, floors last: llvmpipe shades a pixel only if its depth
+        test passes, so what is in front should be drawn first (overdraw is its cost)."""
+        eye = np.asarray(self.uniforms["u_eye"])
+
+        def key(ob):
+            if "floor" in ob:
+                return np.inf
+            c = ob.get("centre")
+            if c is None and "model" in ob:
+                c = ob["model"][:3, 3]
+            return float(np.linalg.norm(c - eye)) if c is not None else 0.0
+        return sorted(self._objects, key=key)
+
     def _draw(self, depth_pass: bool, translucent: bool = False):
+        import moderngl
         vp = self.light_vp if depth_pass else self.vp
-        for ob in self._objects:
+        for ob in (self._objects if depth_pass else self._order()):
             if depth_pass and not ob["casts"]:
                 continue
             look = ob["look"]
@@ -387,6 +388,14 @@ class Renderer:
             vao = ob["dvao"] if depth_pass else ob["vao"]
             prog = vao.program
             _set(prog, "u_vp", vp)
+            if ob["kind"] == "points":
+                if ob["count"]:
+                    for k, v in (("u_color", ob["color"]), ("u_glow", look.glow),
+                                 ("u_radius", ob["radius"]), ("u_px", self.px_per_m),
+                                 ("u_light_dir", self.uniforms["u_light_dir"])):
+                        _set(prog, k, v)
+                    vao.render(moderngl.POINTS, vertices=ob["count"])
+                continue
             if not depth_pass:
                 for k, v in self.uniforms.items():
                     _set(prog, k, v)
@@ -419,7 +428,7 @@ class Renderer:
         ctx = self.ctx
         self._view(t)
         self._update(run, t)
-        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         self.shadow_fbo.use()
         self.shadow_fbo.clear(depth=1.0)
@@ -429,12 +438,15 @@ class Renderer:
         ctx.polygon_offset = (0.0, 0.0)
         self.fbo.use()
         self.fbo.clear(depth=1.0)
-        _set(self.sky, "u_inv_vp", np.linalg.inv(self.vp))
-        for k in ("u_eye", "u_zenith", "u_horizon"):
-            _set(self.sky, k, self.uniforms[k])
-        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
         self.shadow_tex.use(location=0)
         self._draw(depth_pass=False)
+        # the sky on the far plane after the opaque things: shaded only where none is
+        ctx.depth_func = "<="
+        _set(self.sky, "u_inv_vp", np.linalg.inv(self.vp))
+        for k in ("u_eye", "u_zenith", "u_horizon", "u_haze"):
+            _set(self.sky, k, self.uniforms[k])
+        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+        ctx.depth_func = "<"
         # translucent surfaces (water) last, blended over what they cover
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA

@@ -13,12 +13,13 @@ per vertex), cords (instanced cylinders between two points) and knots, hooks and
 SKY_FN = """
 uniform vec3 u_zenith;       // linear RGB
 uniform vec3 u_horizon;
+uniform vec3 u_haze;         // below the horizon: what fog and the floors' edges fade into
 vec3 sky(vec3 dir) {
-    // the sky above the horizon; below it a haze a little darker than the horizon, so that
-    // a scene with no floor reads as standing in front of a backdrop
+    // the sky above the horizon; below it a uniform haze, so that a scene with no floor
+    // reads as standing in front of a backdrop
     float e = dir.z;
-    if (e >= 0.0) return mix(u_horizon, u_zenith, pow(min(e * 1.6, 1.0), 0.7));
-    return u_horizon * mix(1.0, 0.82, min(-e * 3.0, 1.0));
+    if (e >= 0.0) return mix(u_horizon, u_zenith, sqrt(min(e * 1.6, 1.0)));
+    return mix(u_horizon, u_haze, min(-e * 12.0, 1.0));
 }
 """
 
@@ -28,7 +29,7 @@ out vec2 v_ndc;
 void main() {
     vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
     v_ndc = p;
-    gl_Position = vec4(p, 0.9999, 1.0);
+    gl_Position = vec4(p, 1.0, 1.0);  // the far plane: drawn last, only where nothing is
 }
 """
 
@@ -186,7 +187,6 @@ void main() {
         alpha = mix(alpha, 1.0, fres);
     }
     col = 1.0 - exp(-1.6 * col);  // exposure: a lit white cloth keeps its shading, no clipping
-    vec3 dir = -v;
     float fog = clamp((length(to_eye) - u_fog.x) / (u_fog.y - u_fog.x), 0.0, 1.0);
     if (u_fade_w > 0.0) {
         // a floor ends softly: no tile edge against the sky
@@ -194,8 +194,40 @@ void main() {
                          min(v_pos.y - u_fade.z, u_fade.w - v_pos.y));
         fog = max(fog, 1.0 - clamp(edge / u_fade_w, 0.0, 1.0));
     }
-    col = mix(col, sky(dir), fog);
+    col = mix(col, u_haze, fog);
     f_color = vec4(pow(col, vec3(1.0 / 2.2)), alpha);  // gamma 2.2
+}
+"""
+
+POINT_VS = """
+#version 330
+in vec3 in_center;   // per point (m)
+uniform mat4 u_vp;
+uniform float u_radius;  // m
+uniform float u_px;      // pixels per metre at unit distance
+void main() {
+    gl_Position = u_vp * vec4(in_center, 1.0);
+    gl_PointSize = max(2.0, 2.0 * u_radius * u_px / gl_Position.w);
+}
+"""
+
+POINT_FS = """
+#version 330
+uniform vec3 u_color;    // linear RGB
+uniform float u_glow;
+uniform vec3 u_light_dir;
+out vec4 f_color;
+void main() {
+    // a droplet: a lit sphere seen as a disc (one vertex each, where a tessellated sphere
+    // per droplet would cost llvmpipe dozens of triangles)
+    vec2 d = gl_PointCoord * 2.0 - 1.0;
+    float r2 = dot(d, d);
+    if (r2 > 1.0) discard;
+    vec3 n = vec3(d.x, -d.y, sqrt(1.0 - r2));
+    float diff = max(dot(n, normalize(u_light_dir + vec3(0.0, 0.0, 0.5))), 0.0);
+    vec3 col = u_color * (0.45 + 0.55 * diff + u_glow);
+    col = 1.0 - exp(-1.6 * col);
+    f_color = vec4(pow(col, vec3(1.0 / 2.2)), 1.0);
 }
 """
 
