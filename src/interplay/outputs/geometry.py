@@ -61,9 +61,10 @@ def pieces(tris: np.ndarray, n: int) -> list:
 
 
 def chains(segments: np.ndarray, points: np.ndarray) -> list:
-    """Cords as polylines: lists of point indices, each segment in exactly one. At a knot the
-    incident segments are paired straightest-first (the cord goes on through it: a net's
-    strands run through its knots); a segment left unpaired ends its chain there. points
+    """Cords as polylines: lists of point indices, each segment in exactly one. A point
+    between two segments passes the cord on; at a knot the incident segments are paired
+    straightest-first (the cord goes on through it: a net's strands run through its knots);
+    a segment left unpaired ends its chain there. points
     (n,3): the pose the pairing is judged in (the first frame)."""
     seg = np.asarray(segments, dtype=np.int64)
     p = np.asarray(points, dtype=float)
@@ -84,7 +85,9 @@ def chains(segments: np.ndarray, points: np.ndarray) -> list:
                        for j in range(i + 1, len(ss)))
         used = set()
         for cos, i, j in pairs:  # most opposite directions first: the straightest pass
-            if i not in used and j not in used and cos < 0.0:
+            # a point on one cord only (two segments) always passes it on; at a knot a cord
+            # goes on only where the two segments point apart
+            if i not in used and j not in used and (cos < 0.0 or len(ss) == 2):
                 used |= {i, j}
                 follow[(ss[i], knot)] = ss[j]
                 follow[(ss[j], knot)] = ss[i]

@@ -75,8 +75,9 @@ def _quats(R) -> np.ndarray:
 
 TPOSE_JUMP = 5.0  # deg (RMS over the joints): a first frame this far from the second ...
 TPOSE_RATIO = 5.0  # ... and this many times the next frame-to-frame changes is no motion
-STANCE_SPEED = 0.6  # m/s: a sole slower than this, near its lowest, is standing
-STANCE_RISE = 0.02  # m: ... within this of the lowest point it reaches around then
+STANCE_SPEED = 0.8  # m/s: a foot whose ankle or toe joint is slower than this ...
+STANCE_SINK = 0.3  # m/s: ... whose sole moves up or down slower than this ...
+STANCE_RISE = 0.05  # m: ... and is within this of its lowest around then, stands
 
 
 def tpose_first(motion: Motion) -> bool:
@@ -194,35 +195,43 @@ class MocapFigure(System, RigidParts):
             out[:, side] = np.minimum(*low)
         return out
 
-    def plant(self, seg_pos, seg_rot, dt: float, ground) -> np.ndarray:
-        """(F,) vertical offset (m) per frame that puts every stance's sole on the ground:
-        constant through each stance (frames where a sole is slower than STANCE_SPEED within
-        STANCE_RISE of its lowest nearby point), monotone cubic between stances."""
-        from scipy.interpolate import PchipInterpolator
+    @staticmethod
+    def stances(seg_pos, sole, dt: float) -> np.ndarray:
+        """(F, 2) whether the left and the right foot stand in each frame: its ankle or its
+        toe joint (a foot rolls from the one to the other) slower than STANCE_SPEED, its sole
+        neither rising nor sinking faster than STANCE_SINK and within STANCE_RISE of its
+        lowest over the 0.3 s around."""
         from scipy.ndimage import minimum_filter1d
+        out = np.zeros(sole.shape, dtype=bool)
+        for side, pair in enumerate((("l_foot", "l_toes"), ("r_foot", "r_toes"))):
+            speed = np.min([np.linalg.norm(np.gradient(seg_pos[:, SEGMENTS.index(n)], dt,
+                                                       axis=0), axis=1) for n in pair], axis=0)
+            near = minimum_filter1d(sole[:, side], size=max(3, int(0.3 / dt)), mode="nearest")
+            sink = np.abs(np.gradient(sole[:, side], dt))
+            out[:, side] = ((speed < STANCE_SPEED) & (sink < STANCE_SINK)
+                            & (sole[:, side] < near + STANCE_RISE))
+        return out
+
+    def plant(self, seg_pos, seg_rot, dt: float, ground) -> np.ndarray:
+        """(F,) vertical offset (m) per frame that puts the sole of the standing foot on the
+        ground in every stance frame (``stances``: a clip's sole drifts by centimetres within
+        a stance, from retargeting onto capsule feet and marker slip), the mean of the two
+        where both feet stand, and monotone cubic between stances."""
+        from scipy.interpolate import PchipInterpolator
         height = ground if callable(ground) else (lambda x, y, g=float(ground): g)
         sole = self.soles(seg_pos, seg_rot)
+        stand = self.stances(seg_pos, sole, dt)
         F = len(sole)
-        knots_t, knots_v = [], []
+        total, count = np.zeros(F), np.zeros(F)
         for side, name in enumerate(("l_foot", "r_foot")):
             k = SEGMENTS.index(name)
-            speed = np.linalg.norm(np.gradient(seg_pos[:, k], dt, axis=0), axis=1)
-            near = minimum_filter1d(sole[:, side], size=max(3, int(0.3 / dt)), mode="nearest")
-            standing = (speed < STANCE_SPEED) & (sole[:, side] < near + STANCE_RISE)
-            edges = np.flatnonzero(np.diff(np.r_[0, standing.astype(int), 0]))
-            for a, b in zip(edges[::2], edges[1::2]):  # frames a .. b-1 stand
-                if b - a < 3:
-                    continue
-                x, y = seg_pos[a:b, k, :2].mean(axis=0)
-                lift = float(height(x, y)) - float(sole[a:b, side].min())
-                knots_t += [a, b - 1]
-                knots_v += [lift, lift]
-        if not knots_t:
+            for f in np.flatnonzero(stand[:, side]):
+                total[f] += float(height(*seg_pos[f, k, :2])) - float(sole[f, side])
+                count[f] += 1
+        on = count > 0
+        if not on.any():
             return np.zeros(F)
-        order = np.argsort(knots_t, kind="stable")
-        t, v = np.asarray(knots_t, float)[order], np.asarray(knots_v)[order]
-        keep = np.r_[True, np.diff(t) > 0]  # a stance ending where the next starts: one knot
-        t, v = t[keep], v[keep]
+        t, v = np.flatnonzero(on).astype(float), total[on] / count[on]
         if len(t) == 1:
             return np.full(F, v[0])
         return PchipInterpolator(t, v, extrapolate=False)(np.clip(np.arange(F), t[0], t[-1]))
