@@ -46,8 +46,8 @@ def main():
             r.update(material=material, integrator=label, wall_s=time.perf_counter() - t0,
                      density_kg_m2=base.density, mass_ratio=base.density / (1.2 * base.width))
             rows.append(r)
-            print(f"{material:7s} {label:26s} f {r['frequency_hz']:5.2f} Hz  A {r['amplitude_m']:.3f} m"
-                  f" (A/L {r['amplitude_over_length']:.3f})  fL/U {r['reduced_frequency']:.2f}"
+            print(f"{material:7s} {label:26s} f {r['frequency_hz']:5.2f} Hz  "
+                  f"A {r['amplitude_m']:.3f} m (A/L {r['amplitude_over_length']:.3f})  fL/U {r['reduced_frequency']:.2f}"
                   f"  c {r['wave_speed_m_s']:.2f} m/s  [{r['wall_s']:.1f} s]", flush=True)
     out = write_json(args.out, "bench_flutter.json", {
         "what": f"free-edge flutter in a steady {speed} m/s wind, {duration} s, after {settle} s",

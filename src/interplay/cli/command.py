@@ -38,8 +38,10 @@ def _output_options(p):
     g.add_argument("--camera", default=None, metavar="EYE:TARGET[:FOV]",
                    help='preview camera "eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]"'
                         " in m and degrees (default: frame every system)")
-    g.add_argument("--size", default="1280x720", metavar="WxH", help="video size in pixels")
-    g.add_argument("--video-fps", type=float, default=30.0, help="video frames per second")
+    g.add_argument("--size", default="960x540", metavar="WxH",
+                   help="video size in pixels (default 960x540; 1280x720 costs twice as much)")
+    g.add_argument("--video-fps", type=float, default=24.0,
+                   help="video frames per second (default 24, animation's rate)")
     g.add_argument("--usda", action="store_true", help="write text .usda instead of .usdc")
     g.add_argument("--obj", action="store_true",
                    help="also write OBJ sequences (a file per frame per system; off by default)")

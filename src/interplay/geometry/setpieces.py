@@ -78,7 +78,7 @@ def hoop(rim_centre, rim_radius: float) -> list:
             Piece("hoop-pole", *pole, (0.20, 0.22, 0.26), "paint")]
 
 
-def bridge(deck: float, edge: float, platform, anchor, span: float = 50.0) -> list:
+def bridge(deck: float, edge: float, platform, anchor, span: float = 70.0) -> list:
     """A bridge deck at height deck (m) running along y, its side at x = edge - 3 m; the jump
     platform platform = (x0, x1, y0, y1) m jutting out from it to the edge; railings; two
     piers down to the valley floor (z = 0); and the jump arm: two posts at the platform's
@@ -89,7 +89,7 @@ def bridge(deck: float, edge: float, platform, anchor, span: float = 50.0) -> li
     deck_box = box([side - 8.0, -span / 2, deck - 1.4], [side, span / 2, deck])
     slab = box([x0, y0, deck - 0.35], [x1, y1, deck])
     piers = merge(*[box([side - 6.5, y - 1.2, 0.0], [side - 1.5, y + 1.2, deck - 1.4])
-                    for y in (-0.36 * span, 0.36 * span)])
+                    for y in (-0.42 * span, 0.42 * span)])
     rails = []
     for y in np.arange(-span / 2 + 1.0, span / 2, 2.0):
         if not y0 - 0.2 < y < y1 + 0.2:

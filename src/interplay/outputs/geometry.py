@@ -165,3 +165,23 @@ def quat_matrix(q) -> np.ndarray:
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def coarser_height_field(shape, stride: int):
+    """(point indices, Shape) of a height field drawn at every stride-th column each way (the
+    outer ones kept): its faces over the squares whose four corners hold fluid."""
+    from dataclasses import replace
+    xs, ys = np.unique(shape.grid_xy[:, 0]), np.unique(shape.grid_xy[:, 1])
+    nx, ny = len(xs), len(ys)
+    ix = np.unique(np.r_[np.arange(0, nx, stride), nx - 1])
+    iy = np.unique(np.r_[np.arange(0, ny, stride), ny - 1])
+    sub = (ix[:, None] * ny + iy[None, :]).ravel()  # grid_xy rows run j fastest
+    fluid = np.zeros(nx * ny, dtype=bool)
+    fluid[shape.triangles.ravel()] = True
+    f = fluid[sub].reshape(len(ix), len(iy))
+    idx = np.arange(len(sub)).reshape(len(ix), len(iy))
+    ok = (f[:-1, :-1] & f[1:, :-1] & f[:-1, 1:] & f[1:, 1:]).ravel()
+    a, b = idx[:-1, :-1].ravel()[ok], idx[1:, :-1].ravel()[ok]
+    c, d = idx[1:, 1:].ravel()[ok], idx[:-1, 1:].ravel()[ok]
+    tris = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    return sub, replace(shape, triangles=tris, grid_xy=shape.grid_xy[sub], base=shape.base[sub])

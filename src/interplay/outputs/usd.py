@@ -9,8 +9,9 @@ Stage layout (``/World`` is the default prim):
   /World/<figure>/pelvis/torso/head ...   a figure or rig (the bicyclist): one Xform per part,
                             named after it and nested under its parent, its transform relative
                             to the parent's, each over its static mesh .../<part>/geom
-  /World/<surface>          Mesh with time-sampled points, normals, velocities (m/s: motion
-                            blur) and extent, texture coordinates primvars:st from its rest
+  /World/<surface>          Mesh with time-sampled points, normals (not for a height field:
+                            they follow from its points), velocities (m/s: motion blur) and
+                            extent, texture coordinates primvars:st from its rest
                             pose, doubleSided for cloth; a surface of several separate pieces
                             (the leaves) is an Xform with one such Mesh per piece
                             /World/leaves/leaves_00 ...; a height field (water) also has
@@ -220,12 +221,15 @@ def _surface(stage, path, shape, fr, looks):
     for k, (idx, tris) in enumerate(parts):
         p_path = path if len(parts) == 1 else f"{path}/{prim_name(shape.name)}_{k:02d}"
         mesh = _mesh(stage, p_path, None, tris, shape.double_sided)
-        pa, na, va, ea = (mesh.CreatePointsAttr(), mesh.CreateNormalsAttr(),
-                          mesh.CreateVelocitiesAttr(), mesh.CreateExtentAttr())
+        pa, va, ea = mesh.CreatePointsAttr(), mesh.CreateVelocitiesAttr(), mesh.CreateExtentAttr()
+        # a height field's normals follow from its points (a DCC computes them); authoring
+        # them per frame would double the water's share of the stage
+        na = None if water else mesh.CreateNormalsAttr()
         for i in range(len(pts)):
             p = pts[i][idx]
             pa.Set(_vec3f(p), i)
-            na.Set(_vec3f(vertex_normals(p, tris)), i)
+            if na is not None:
+                na.Set(_vec3f(vertex_normals(p, tris)), i)
             va.Set(_vec3f(vel[i][idx]), i)
             ea.Set(_extent(p), i)
         if water:

@@ -31,8 +31,8 @@ class OutputOptions:
     obj: bool = False  # OBJ sequences are opt-in (--obj): a file per frame per system
     video: bool = True
     report: bool = True
-    size: tuple = (1280, 720)
-    video_fps: float = 30.0
+    size: tuple = (960, 540)  # px: a preview that renders beside the other outputs
+    video_fps: float = 24.0  # frames/s: animation's rate
     camera: Camera | None = None
     quiet: bool = False
     timings: dict = field(default_factory=dict, compare=False)

@@ -174,5 +174,5 @@ SPEC = SceneSpec(
     LeavesParams, couplings=("one-way",), duration=4.0, fps=60.0,
     integrators=("explicit", "implicit", "localglobal"),
     # low over the leaves, panning a little with the rider as he rides through
-    camera=TrackingCamera("bicyclist", offset=(0.6, -5.2, 1.8), target_offset=(0.3, 0.5, 0.3),
-                          axes=(0.15, 0.0, 0.0), fov_deg=42.0, smooth_s=0.3))
+    camera=TrackingCamera("bicyclist", offset=(0.5, -4.3, 1.5), target_offset=(0.3, 0.4, 0.35),
+                          axes=(0.15, 0.0, 0.0), fov_deg=40.0, smooth_s=0.3), key_time=1.25)

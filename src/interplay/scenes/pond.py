@@ -105,4 +105,4 @@ SPEC = SceneSpec(
     "pond", "balls of different densities float, bob and sink in a pond (two-way)", build,
     PondParams, couplings=("two-way", "one-way", "hybrid"), duration=4.0, fps=60.0,
     # from the bank, a little above: the pond and its balls fill the frame
-    camera=Camera((1.1, -1.75, 1.05), (0.0, 0.0, 0.25), 45.0))
+    camera=Camera((1.1, -1.75, 1.05), (0.0, 0.0, 0.25), 45.0), key_time=0.7)

@@ -129,5 +129,5 @@ SPEC = SceneSpec(
     "puddle", "a motion-captured runner's foot steps in a shallow puddle and splashes it "
     "(one-way)", build, PuddleParams, couplings=("one-way",), duration=1.5, fps=60.0,
     # low and to the side of the puddle, panning half way with the runner
-    camera=TrackingCamera("runner", offset=(0.3, -3.3, 0.75), target_offset=(0.0, 0.0, 0.5),
-                          axes=(0.5, 0.0, 0.0), fov_deg=40.0, smooth_s=0.3))
+    camera=TrackingCamera("runner", offset=(0.3, -3.6, 0.45), target_offset=(0.0, 0.0, 0.75),
+                          axes=(0.5, 0.0, 0.0), fov_deg=40.0, smooth_s=0.3), key_time=0.95)

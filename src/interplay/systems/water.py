@@ -266,10 +266,11 @@ class Water(System):
         idx = np.arange(nx * ny).reshape(nx, ny)
         a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
         c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
-        # sand below the highest still water, grass on the banks above it
+        # sand below the highest still water, turning to the banks' colour up to the rim
         wet = self.fluid & (self.V > 0.0)
         level = float(np.max(np.where(wet, self.bed + self.V / self.area, -np.inf)))
-        up = np.clip((bed.ravel() - level) / 0.03, 0.0, 1.0)[:, None]
+        up = np.clip((bed.ravel() - level) / max(float(self.bed.max()) - level, 1e-3), 0.0,
+                     1.0)[:, None]
         colors = (1 - up) * np.asarray(self.bed_color) + up * np.asarray(self.bank_color)
         verts = np.stack([X[np.ix_(ix, iy)].ravel(), Y[np.ix_(ix, iy)].ravel(), bed.ravel()], 1)
         out.append(Shape(f"{self.name}-bed", "static", color=self.bed_color, verts=verts,

@@ -16,7 +16,7 @@ import numpy as np
 
 from ...errors import InterplayError
 from ...systems.shape import MATERIALS
-from ..geometry import vertex_normals, wet_surface
+from ..geometry import coarser_height_field, vertex_normals, wet_surface
 from . import shaders
 from .camera import Camera, TrackingCamera, cameras, default_camera
 
@@ -25,8 +25,8 @@ HORIZON = np.array([0.78, 0.82, 0.86])  # ... and at the horizon
 HAZE = np.array([0.66, 0.69, 0.72])     # below the horizon: the backdrop fog fades into
 SUN = np.array([0.30, -0.50, 1.0]) / np.linalg.norm([0.30, -0.50, 1.0])  # towards the sun
 HOOK_COLOR = (0.12, 0.12, 0.13)
-PENUMBRA = 0.02  # m, width of the soft shadow edge
 THIN = 0.45  # share of the sun a sunlit cloth or leaf shows on its shaded side
+WATER_POINTS = 9000  # columns above which the preview draws a height field at every 2nd one
 GL_HINT = ("install the Mesa EGL driver (`make` does it, or apt-get install -y libegl1 "
            "libegl-mesa0 libgl1-mesa-dri) or skip the video with --no-video")
 
@@ -111,7 +111,7 @@ class Renderer:
     a TrackingCamera, or None for a default that frames every animated system over the whole
     run."""
 
-    def __init__(self, run, size=(1280, 720), camera=None, samples: int = 4,
+    def __init__(self, run, size=(960, 540), camera=None, samples: int = 4,
                  shadow_size: int = 512):
         self.ctx = ctx = gl_context()
         self.w, self.h = int(size[0]), int(size[1])
@@ -202,8 +202,6 @@ class Renderer:
         ortho[2, 3] = -1.0  # view depth 0..depth -> -1..1
         self.light_vp = ortho @ Camera(tuple(eye), tuple(centre)).view()
         self.uniforms.update({"u_light_vp": self.light_vp,
-                              # a penumbra of ~2.5 cm, in shadow-map uv units
-                              "u_spread": PENUMBRA / (2 * r),
                               # ~4 mm of depth and 1.5 texels of normal offset
                               "u_bias": 0.004 / depth,
                               "u_offset": 1.5 * 2 * r / self.shadow_size})
@@ -262,13 +260,19 @@ class Renderer:
                            extent=float(np.linalg.norm(v, axis=1).max()))
         elif shape.form == "surface":
             n = len(run.frames[shape.name]["points"][0])
+            water, sub = shape.base is not None, None
+            if water and n > WATER_POINTS:
+                # a preview needs no more columns than it has pixels for: llvmpipe's cost is
+                # per triangle as much as per pixel (the USD stage keeps every column)
+                sub, shape = coarser_height_field(shape, 2)
+                n = len(sub)
             vbo = self._buffer(np.zeros((n, 10)), dynamic=True)
             ibo = self._index(shape.triangles, dynamic=True)
             vao, dvao = self._vaos("mesh", vbo, ibo)
-            water = shape.base is not None
             self._objects.append({"shape": shape, "kind": "surface", "vao": vao, "dvao": dvao,
                                   "vbo": vbo, "ibo": ibo, "look": shape.look, "water": water,
                                   "rgba": _rgba(shape, n), "count": len(shape.triangles),
+                                  "sub": sub,
                                   # a water surface lets the light through to its bed
                                   "casts": not water})
         elif shape.form == "cords":
@@ -330,6 +334,8 @@ class Renderer:
                 boxes += [pos - r, pos + r]
             elif ob["kind"] == "surface":
                 p, rgba, tris = st["points"], ob["rgba"], shape.triangles
+                if ob["sub"] is not None:
+                    p = p[ob["sub"]]
                 if ob["water"]:
                     p, alpha, wet = wet_surface(shape, p)
                     tris = tris[wet]

@@ -5,7 +5,7 @@ horizon, so a scene without a floor stands in front of a backdrop rather than on
 one), then one lit fragment shader (hemisphere ambient + sun diffuse and specular by material,
 soft shadows by percentage-closer filtering of a shadow map, a checker and an edge fade for
 floors, Fresnel reflection of the sky and transmission for water, distance fog into the sky,
-output gamma 2.2) for three vertex shaders: meshes (a model matrix, a colour and an opacity
+output gamma 2) for three vertex shaders: meshes (a model matrix, a colour and an opacity
 per vertex), cords (instanced cylinders between two points) and knots, hooks and particles
 (instanced spheres). Shadow-map passes reuse the vertex shaders with an empty fragment shader.
 """
@@ -43,7 +43,7 @@ out vec4 f_color;
 void main() {
     vec4 w = u_inv_vp * vec4(v_ndc, 1.0, 1.0);
     vec3 dir = normalize(w.xyz / w.w - u_eye);
-    f_color = vec4(pow(sky(dir), vec3(1.0 / 2.2)), 1.0);
+    f_color = vec4(sqrt(sky(dir)), 1.0);
 }
 """
 
@@ -122,7 +122,6 @@ uniform vec3 u_eye;
 uniform vec3 u_light_dir;    // unit, towards the sun
 uniform mat4 u_light_vp;
 uniform sampler2DShadow u_shadow;
-uniform float u_spread;      // penumbra width in shadow-map uv units
 uniform float u_bias;
 uniform float u_offset;      // m: shadow lookups start this far off the surface
 uniform int u_checker;       // 1: a floor's 0.5 m checker
@@ -144,14 +143,9 @@ float lit_fraction(vec3 p, vec3 n) {
     vec4 lp = u_light_vp * vec4(p + nl * u_offset, 1.0);
     vec3 c = lp.xyz / lp.w * 0.5 + 0.5;
     if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0)))) return 1.0;
-    // four taps, each a hardware 2x2 comparison (bilinear PCF), on a rotated grid across the
-    // penumbra: llvmpipe runs every texture() of the shader for every pixel (it does not
-    // branch around them), so the tap count is the cost
-    float z = c.z - u_bias;
-    vec2 a = vec2(0.38, 0.13) * u_spread;
-    vec2 b = vec2(-0.13, 0.38) * u_spread;
-    return 0.25 * (texture(u_shadow, vec3(c.xy + a, z)) + texture(u_shadow, vec3(c.xy - a, z))
-                 + texture(u_shadow, vec3(c.xy + b, z)) + texture(u_shadow, vec3(c.xy - b, z)));
+    // one hardware 2x2 comparison, filtered bilinearly: a soft edge a texel wide. llvmpipe
+    // runs every texture() of the shader for every pixel, so each tap is paid everywhere
+    return texture(u_shadow, vec3(c.xy, c.z - u_bias));
 }
 
 void main() {
@@ -195,7 +189,7 @@ void main() {
         fog = max(fog, 1.0 - clamp(edge / u_fade_w, 0.0, 1.0));
     }
     col = mix(col, u_haze, fog);
-    f_color = vec4(pow(col, vec3(1.0 / 2.2)), alpha);  // gamma 2.2
+    f_color = vec4(sqrt(col), alpha);  // gamma 2 (sqrt: llvmpipe's pow costs two exps)
 }
 """
 
@@ -227,7 +221,7 @@ void main() {
     float diff = max(dot(n, normalize(u_light_dir + vec3(0.0, 0.0, 0.5))), 0.0);
     vec3 col = u_color * (0.45 + 0.55 * diff + u_glow);
     col = 1.0 - exp(-1.6 * col);
-    f_color = vec4(pow(col, vec3(1.0 / 2.2)), 1.0);
+    f_color = vec4(sqrt(col), 1.0);
 }
 """
 
