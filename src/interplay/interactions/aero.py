@@ -63,3 +63,74 @@ class Aerodynamics(Interaction):
         if to_secondary:
             self.body.apply(self._idx, f, self._dfdx, dfdv)
         return -total, np.zeros(3), True
+
+
+@dataclass(frozen=True)
+class CordDragParams:
+    """The air on a cord (a kite's flying line, a tail's string) and on small bluff bodies
+    along it (a tail's bows). density: rho (kg/m^3); drag: C_D of a cylinder in cross flow
+    (~1.1-1.2 at a line's Reynolds numbers of 1e2-1e3, Hoerner, *Fluid-Dynamic Drag*, 1965,
+    ch. 3); friction: C_f along it (skin friction on the wetted circumference); bow_drag: C_D
+    of a bow (a crumpled ribbon: ~1); bow_area (m^2): the frontal area of each bow."""
+    density: float = 1.2
+    drag: float = 1.1
+    friction: float = 0.01
+    bow_drag: float = 1.0
+    bow_area: float = 0.0
+
+
+class CordDrag(Interaction):
+    """Drag on every segment of ``cord`` (a network seen as points with segments; its
+    ``thickness`` is the cord's radius) and on its ``bows`` (point indices), from the wind at
+    each segment's middle and each bow, at the cord's own time (``kernels.aero``: cross-flow
+    drag on the velocity across the cord, skin friction along it, quadratic drag on bows).
+    Like ``Aerodynamics`` it is one-way: the reaction is logged on the wind, never applied;
+    implicit cords get the forces' velocity Jacobian."""
+
+    def __init__(self, name, wind, cord, params: CordDragParams = CordDragParams(), bows=(),
+                 mode="one-way"):
+        super().__init__(name, wind, cord, mode)
+        self.body = cord.contact_view()
+        if (self.body is None or self.body.kind != "points" or self.body.segments is None
+                or not len(self.body.segments)):
+            raise ParameterError(f"interaction {name}: {cord.name} has no segments; cord "
+                                 "drag needs a network of springs")
+        rho = require_nonnegative(name, "density", params.density, "kg/m^3")
+        d = 2.0 * self.body.thickness
+        self.seg = np.ascontiguousarray(self.body.segments, dtype=np.int64)
+        self.cn = 0.5 * rho * require_nonnegative(name, "drag", params.drag) * d
+        self.ct = 0.5 * rho * require_nonnegative(name, "friction", params.friction) * np.pi * d
+        self.bows = np.asarray(bows, dtype=np.int64).reshape(-1)
+        n = len(self.body.x)
+        if len(self.bows) and (self.bows.min() < 0 or self.bows.max() >= n):
+            raise ParameterError(f"{name}: bows {self.bows.tolist()} must be points 0..{n - 1} "
+                                 f"of {cord.name}")
+        area = require_nonnegative(name, "bow_area", params.bow_area, "m^2")
+        self.cd_area = np.full(len(self.bows), 0.5 * rho * require_nonnegative(
+            name, "bow_drag", params.bow_drag) * area)
+        self._idx = np.arange(n)
+        self._f = np.zeros((n, 3))
+        self._dfdx = np.zeros((n, 3, 3))
+        self._dfdv = np.zeros((n, 3, 3))
+        self._mid = np.zeros((len(self.seg), 3))
+
+    def forces(self, with_jacobian=False):
+        """(point forces (n,3) N, their velocity Jacobian (n,3,3) N s/m, total force (3,) N)."""
+        body, t = self.body, self.body.time
+        K.midpoints(body.x, self.seg, self._mid)
+        self._f[:] = 0.0
+        if with_jacobian:
+            self._dfdv[:] = 0.0
+        total = K.segment_forces(body.x, body.v, self.seg, self.primary.velocity(self._mid, t),
+                                 self.cn, self.ct, self._f, self._dfdv, with_jacobian)
+        if len(self.bows):
+            total = total + K.point_forces(body.v, self.bows,
+                                           self.primary.velocity(body.x[self.bows], t),
+                                           self.cd_area, self._f, self._dfdv, with_jacobian)
+        return self._f, self._dfdv, total
+
+    def exchange(self, to_primary, to_secondary):
+        f, dfdv, total = self.forces(self.body.jacobians)
+        if to_secondary:
+            self.body.apply(self._idx, f, self._dfdx, dfdv)
+        return -total, np.zeros(3), True

@@ -1,7 +1,9 @@
 """Attachments: stiff damped zero-length springs between network points and points fixed on
-the rigid parts of another system (a cord's two ankle straps tied to a figure's ankles).
-Equal and opposite forces; two-way or one-way. One interaction carries all the ties between a
-network and a body, so its force log is the whole pull of the network on it."""
+the rigid parts of another system (a cord's two ankle straps tied to a figure's ankles, a kite's
+sail tied along its spars, its bridle to the frame, its lines to a pilot's handles). Two-way or
+one-way. One interaction carries all the ties between a network and a body, so its force log
+is the whole pull of the network on it; the ties are evaluated together (no Python loop per
+tie) and each tied part gets one wrench, the sum of its ties'."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -20,13 +22,32 @@ class AttachmentParams:
 
 
 class SegmentAttachment(Interaction):
-    """Ties network points to ``local`` (m, in the part's frame) on parts of a body: ``ties`` is
-    a sequence of (network point index, part name), each tie a spring of the given stiffness
-    and damping. The body (a figure, a rigid body: anything seen as rigid parts) is the
-    primary, the network (seen as points) the secondary."""
+    """Ties network points to points ``local`` (m, in the part's frame: one (3,) for every tie
+    or one row (n,3) per tie) on parts of a body: ``ties`` is a sequence of (network point
+    index, part name), each tie a spring of the given stiffness and damping. The body (a
+    figure, a rigid body: anything seen as rigid parts) is the primary, the network (seen as
+    points) the secondary.
+
+    carry=False: the body feels each tie's force, equal and opposite to the network's, held
+    over the coupling step: explicit on the body's side. That is stable while the ties are
+    soft beside the mass they drag along in a step (k h^2 < m: a flying line, a tail), but a
+    network tied stiffly to a body lighter than about twice itself is unstable at any step
+    (the added-mass instability of partitioned schemes: Causin, Gerbeau & Nobile, CMAME 194,
+    2005): a sail sewn to its spars. carry=True (one tied part, of a body that carries points:
+    a free rigid body): the part carries the whole network, as a frame carries its sail. The
+    network's mass and inertia are added to the part's over the step and the part feels every
+    force on the network's points at the step's end except the ties' (their weight, the air,
+    the ground: the springs between them cancel, and so do their moments), while the network
+    moves on its own, held to the part by the ties. The part then moves as the body and
+    network would if rigidly joined, under the network's loads as its shape makes them: the
+    mean-axis approximation of flexible flight dynamics, which neglects the inertial
+    coupling of the deformation (Waszak & Schmidt, J. Aircraft 25(6), 1988). Momentum is
+    exact for the composite; the true momentum differs from it by the network's momentum
+    relative to the part, which stays bounded. Stable for any mass ratio."""
 
     def __init__(self, name, body, network, ties, local=(0.0, 0.0, 0.0),
-                 params: AttachmentParams = AttachmentParams(), mode="two-way"):
+                 params: AttachmentParams = AttachmentParams(), mode="two-way",
+                 carry: bool = False):
         super().__init__(name, body, network, mode)
         self.k = require_positive(name, "stiffness", params.stiffness, "N/m")
         self.c = require_nonnegative(name, "damping", params.damping, "N s/m")
@@ -42,11 +63,23 @@ class SegmentAttachment(Interaction):
             raise ParameterError(f"{name}: tie points {self.index.tolist()} must be points "
                                  f"0..{len(self.net.x) - 1} of {network.name}")
         self.parts = np.array([self.body.part(part) for _, part in ties], dtype=np.int64)
-        self.local = np.asarray(local, dtype=float)
         n = len(ties)
+        local = np.asarray(local, dtype=float)
+        if local.shape not in ((3,), (n, 3)) or not np.all(np.isfinite(local)):
+            raise ParameterError(f"{name}: local tie points must be one finite (3,) point or "
+                                 f"one per tie ({n},3) m, got shape {local.shape}")
+        self.local = np.broadcast_to(local, (n, 3)).copy()
+        # the parts tied, once each: velocities are asked for once per part, wrenches summed
+        self._uniq, self._inv = np.unique(self.parts, return_inverse=True)
+        self.carry = bool(carry)
+        if self.carry and len(self._uniq) > 1:
+            raise ParameterError(f"{name}: a carried network is tied to one part, not "
+                                 f"{len(self._uniq)}; tie {network.name} to one part or use "
+                                 "carry=False")
         self._jac = np.broadcast_to(-self.k * np.eye(3), (n, 3, 3)).copy()
         self._djac = np.broadcast_to(-self.c * np.eye(3), (n, 3, 3)).copy()
         self._f = np.zeros((n, 3))
+        self._held = np.zeros((n, 3))  # the tie forces held on the network over the step
         self._p = np.zeros((n, 3))
         self._v = np.zeros((n, 3))
         self._h = 0.0
@@ -55,11 +88,10 @@ class SegmentAttachment(Interaction):
         """World positions (m) and velocities (m/s) of the tie points, from the body's current
         state (a figure's advance leaves its kinematics and velocities current)."""
         pos, R = self.body.poses()
-        lin, ang = self.body.velocities(self.parts)
-        com = self.body.centres()
-        for k, part in enumerate(self.parts):
-            self._p[k] = pos[part] + R[part] @ self.local
-            self._v[k] = lin[k] + np.cross(ang[k], self._p[k] - com[part])
+        lin, ang = self.body.velocities(self._uniq)
+        com = self.body.centres()[self.parts]
+        self._p[:] = pos[self.parts] + np.einsum("kij,kj->ki", R[self.parts], self.local)
+        self._v[:] = lin[self._inv] + np.cross(ang[self._inv], self._p - com)
 
     def prepare(self, h, dts=None):
         self._h = h
@@ -72,26 +104,54 @@ class SegmentAttachment(Interaction):
         net, i = self.net, self.index
         self._f[:] = self.k * (net.x[i] - self._p) + self.c * (net.v[i] - self._v)
         if to_secondary:
-            net.apply(i, -self._f, self._jac, self._djac, self._v)
+            self._held[:] = -self._f
+            net.apply(i, self._held, self._jac, self._djac, self._v)
             return None
+        self._held[:] = 0.0
         return self._finish(to_primary)
 
     def complete(self, to_primary):
-        """After the network's step: the tie force at its end, the network points where the
-        implicit step put them and the tie points carried on at their velocities, i.e. what
-        the network was pulled with over the step. For a massless network end it is what the
-        rest of the network transmits, so a slack light cord leaves the body alone (no
-        added mass of k h^2 + c h from a tie force lagging the body's acceleration)."""
+        """After the network's step. Not carried: the tie force at its end, the network points
+        where the implicit step put them and the tie points carried on at their velocities,
+        i.e. what the network was pulled with over the step (for a massless network end, what
+        the rest of the network transmits: a slack light cord leaves the body alone). Carried:
+        the network's load (``_carry``)."""
         net, i = self.net, self.index
+        if self.carry:
+            return self._carry(to_primary)
         target = self._p + self._h * self._v
         self._f[:] = self.k * (net.x[i] - target) + self.c * (net.v[i] - self._v)
         return self._finish(to_primary)
 
     def _finish(self, to_primary):
-        com = self.body.centre_of_mass()
-        torque = np.zeros(3)
-        for k, part in enumerate(self.parts):
-            if to_primary:
-                self.body.apply(int(part), self._f[k], point=self._p[k])
-            torque += np.cross(self._p[k] - com, self._f[k])
+        """Each tied part gets the sum of its ties' forces at its centre of mass and the sum
+        of their moments about it (the same wrench as each force at its own point)."""
+        if to_primary:
+            r = self._p - self.body.centres()[self.parts]
+            force = np.zeros((len(self._uniq), 3))
+            moment = np.zeros((len(self._uniq), 3))
+            np.add.at(force, self._inv, self._f)
+            np.add.at(moment, self._inv, np.cross(r, self._f))
+            for u, part in enumerate(self._uniq):  # once per part, not per tie
+                self.body.apply(int(part), force[u], torque=moment[u])
+        torque = np.cross(self._p - self.body.centre_of_mass(), self._f).sum(axis=0)
         return self._f.sum(axis=0), torque, True
+
+    def _carry(self, to_primary):
+        """Give the part the network to carry: its mass, its inertia about the part's centre
+        of mass and every force on its points at the step's end but the ties' (the sum of
+        each point's mass times its acceleration, less the ties' held forces), with their
+        moment about the part's centre at the points' own positions."""
+        net, part = self.net, int(self._uniq[0])
+        load = net.accelerations() * net.masses[:, None]
+        np.subtract.at(load, self.index, self._held)
+        c = self.body.centres()[part]
+        r = net.x - c
+        force, moment = load.sum(axis=0), np.cross(r, load).sum(axis=0)
+        if to_primary:
+            m = net.masses
+            inertia = (m * np.einsum("ki,ki->k", r, r)).sum() * np.eye(3) - np.einsum(
+                "k,ki,kj->ij", m, r, r)
+            self.body.apply(part, force, torque=moment, carried=(m.sum(), inertia))
+        torque = moment + np.cross(c - self.body.centre_of_mass(), force)
+        return force, torque, True

@@ -78,3 +78,100 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian):
                         eye = 1.0 if a == b else 0.0
                         dfdv[p, a, b] -= (dn * nn[a] * nn[b] + dt * (eye - nn[a] * nn[b])) / 3.0
     return total
+
+
+@njit(cache=True)
+def midpoints(x, seg, out):
+    """out[s] = the middle of segment s's two points (m)."""
+    for s in range(seg.shape[0]):
+        for c in range(3):
+            out[s, c] = 0.5 * (x[seg[s, 0], c] + x[seg[s, 1], c])
+
+
+@njit(cache=True)
+def segment_forces(x, v, seg, wind, cn, ct, f, dfdv, with_jacobian):
+    """Add each cord segment's drag, half to each end point, to f (n,3) N; return the total.
+
+    A segment of unit direction t, length l and diameter d (cn = 1/2 rho C_D d, kg/m^2;
+    ct = 1/2 rho C_f pi d, kg/m^2), moving at v (the mean of its ends' velocities minus the
+    wind at its middle) relative to the air, feels the cross-flow drag of a cylinder on the
+    part of v across it (the independence principle) and skin friction along it:
+
+        f = -cn l |v_n| v_n - ct l |v_t| v_t,   v_t = (v.t) t,  v_n = v - v_t.
+
+    dfdv (n,3,3) receives the exact derivative with respect to v (symmetric negative
+    semidefinite: -cn l (|v_n| P + v_n v_n^T / |v_n|) - 2 ct l |v.t| t t^T, P = I - t t^T),
+    lumped as 1/2 to each end (the row sum over the two points sharing the velocity)."""
+    total = np.zeros(3)
+    for s in range(seg.shape[0]):
+        i, j = seg[s, 0], seg[s, 1]
+        t0 = x[j, 0] - x[i, 0]
+        t1 = x[j, 1] - x[i, 1]
+        t2 = x[j, 2] - x[i, 2]
+        ln = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        if ln == 0.0:
+            continue
+        t0 /= ln
+        t1 /= ln
+        t2 /= ln
+        r0 = 0.5 * (v[i, 0] + v[j, 0]) - wind[s, 0]
+        r1 = 0.5 * (v[i, 1] + v[j, 1]) - wind[s, 1]
+        r2 = 0.5 * (v[i, 2] + v[j, 2]) - wind[s, 2]
+        vt = r0 * t0 + r1 * t1 + r2 * t2
+        n0 = r0 - vt * t0
+        n1 = r1 - vt * t1
+        n2 = r2 - vt * t2
+        vn = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+        a = cn * ln * vn
+        b = ct * ln * abs(vt)
+        f0 = -a * n0 - b * vt * t0
+        f1 = -a * n1 - b * vt * t1
+        f2 = -a * n2 - b * vt * t2
+        total[0] += f0
+        total[1] += f1
+        total[2] += f2
+        for p in (i, j):
+            f[p, 0] += 0.5 * f0
+            f[p, 1] += 0.5 * f1
+            f[p, 2] += 0.5 * f2
+        if with_jacobian:
+            tt = (t0, t1, t2)
+            nn = (n0, n1, n2)
+            inv = 1.0 / vn if vn > 0.0 else 0.0
+            for p in (i, j):
+                for r in range(3):
+                    for c in range(3):
+                        eye = 1.0 if r == c else 0.0
+                        d = (a * (eye - tt[r] * tt[c]) + cn * ln * nn[r] * nn[c] * inv
+                             + 2.0 * b * tt[r] * tt[c])
+                        dfdv[p, r, c] -= 0.5 * d
+    return total
+
+
+@njit(cache=True)
+def point_forces(v, idx, wind, cd_area, f, dfdv, with_jacobian):
+    """Add the drag of small bluff bodies at points idx (a tail's bows) to f (n,3) N; return
+    the total: f = -cd_area |v| v with v the point's velocity minus the wind there (wind (b,3))
+    and cd_area (b,) = 1/2 rho C_D A (kg/m). dfdv gets -cd_area (|v| I + v v^T / |v|)."""
+    total = np.zeros(3)
+    for b in range(idx.shape[0]):
+        p = idx[b]
+        r0 = v[p, 0] - wind[b, 0]
+        r1 = v[p, 1] - wind[b, 1]
+        r2 = v[p, 2] - wind[b, 2]
+        speed = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+        c = cd_area[b] * speed
+        f[p, 0] -= c * r0
+        f[p, 1] -= c * r1
+        f[p, 2] -= c * r2
+        total[0] -= c * r0
+        total[1] -= c * r1
+        total[2] -= c * r2
+        if with_jacobian:
+            rr = (r0, r1, r2)
+            inv = cd_area[b] / speed if speed > 0.0 else 0.0
+            for r in range(3):
+                dfdv[p, r, r] -= c
+                for q in range(3):
+                    dfdv[p, r, q] -= inv * rr[r] * rr[q]
+    return total

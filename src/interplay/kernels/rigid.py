@@ -21,12 +21,17 @@ class Body(NamedTuple):
 
 
 class Wrench(NamedTuple):
-    """The force (3,) N and torque about the centre (3,) N m held over a step, and the force's
-    Jacobians kext = dF/dx (3,3) N/m and dext = dF/dv (3,3) N s/m (zero when it has none)."""
+    """The force (3,) N and torque about the centre (3,) N m held over a step, the force's
+    Jacobians kext = dF/dx (3,3) N/m and dext = dF/dv (3,3) N s/m (zero when it has none), and
+    what the body carries over the step: carried (4,) [mass kg, then nothing] and
+    carried_inertia (3,3) kg m^2 about its centre, world axes: points of another system tied
+    to it that it accelerates with itself (their other forces are in force and torque)."""
     force: np.ndarray
     torque: np.ndarray
     kext: np.ndarray
     dext: np.ndarray
+    carried: np.ndarray
+    carried_inertia: np.ndarray
 
 
 @njit(cache=True)
@@ -62,10 +67,13 @@ def rigid_step(body, wrench, h):
     the restitution its damping gives (held explicitly, a 1e5 N/m floor at 1e-3 s would add
     energy at every bounce). With zero Jacobians it is the exact update above.
     Rotation integrates Euler's equations explicitly in the world frame and applies the exact
-    rotation exp(h w) to q. Arrays are updated in place.
+    rotation exp(h w) to q. Carried mass and inertia (points riding on the body) add to its
+    own in the accelerations (not in its weight: their weight is among the forces). Arrays are
+    updated in place.
     """
-    x, v, q, w, mass, inertia_body, gravity = body
-    force, torque, kext, dext = wrench
+    x, v, q, w, own_mass, inertia_body, gravity = body
+    force, torque, kext, dext, carried, carried_inertia = wrench
+    mass = own_mass + carried[0]
     stiff = False
     for i in range(3):
         for j in range(3):
@@ -80,7 +88,7 @@ def rigid_step(body, wrench, h):
                 A[i, j] = -0.5 * h * dext[i, j] - 0.25 * h * h * kext[i, j]
                 kv += kext[i, j] * v[j]
             A[i, i] += mass
-            b[i] = h * (force[i] + mass * gravity[i] + 0.5 * h * kv)
+            b[i] = h * (force[i] + own_mass * gravity[i] + 0.5 * h * kv)
         Ainv = np.empty((3, 3))
         inv3(A, Ainv)
         for i in range(3):
@@ -89,11 +97,11 @@ def rigid_step(body, wrench, h):
             v[i] += dv
     else:
         for i in range(3):
-            a = force[i] / mass + gravity[i]
+            a = (force[i] + own_mass * gravity[i]) / mass
             x[i] += h * v[i] + 0.5 * h * h * a
             v[i] += h * a
     R = quat_to_matrix(q)
-    Iw = R @ np.diag(inertia_body) @ R.T
+    Iw = R @ np.diag(inertia_body) @ R.T + carried_inertia
     L = Iw @ w
     gyro = np.cross(w, L)
     dw = np.linalg.solve(Iw, torque - gyro)

@@ -15,11 +15,16 @@ the core, peaks at r = r_c and vanishes at the centre instead of diverging.
 * TURBULENCE: frozen turbulence carried along with c (Taylor's hypothesis): a sum of Fourier
   modes v = sum_m s A_m cos(k_m . d + phi_m), each divergence-free (A_m perpendicular to k_m);
   modes (M, 8) rows [owner primitive, k (1/m), A (unit rms), phi (rad)], strength s (m/s rms).
+* BOUNDARY_LAYER: the wind over flat ground at height c_z, the logarithmic profile of the
+  atmospheric surface layer (Prandtl; e.g. Stull, *An Introduction to Boundary Layer
+  Meteorology*, 1988, sec. 9.7): v = s ln(1 + z / z0) a for z = p_z - c_z > 0, else 0; z0 = r_c
+  the roughness length (m); s (m/s) is the speed at a reference height z_r divided by
+  ln(1 + z_r / z0) (``systems.wind``). The 1 + keeps the profile finite and zero at the ground.
 """
 import numpy as np
 from numba import njit
 
-UNIFORM, SOURCE, VORTEX, TURBULENCE = 0, 1, 2, 3
+UNIFORM, SOURCE, VORTEX, TURBULENCE, BOUNDARY_LAYER = 0, 1, 2, 3, 4
 
 
 @njit(cache=True)
@@ -43,7 +48,13 @@ def sample(points, kind, centre, axis, strength, core, modes, out):
             d1 = points[i, 1] - centre[q, 1]
             d2 = points[i, 2] - centre[q, 2]
             rc2 = core[q] * core[q]
-            if kind[q] == TURBULENCE:
+            if kind[q] == BOUNDARY_LAYER:
+                if d2 > 0.0:
+                    c = s * np.log1p(d2 / core[q])
+                    o0 += c * a0
+                    o1 += c * a1
+                    o2 += c * a2
+            elif kind[q] == TURBULENCE:
                 for m in range(modes.shape[0]):
                     if int(modes[m, 0]) != q:
                         continue

@@ -54,7 +54,10 @@ class RigidBody(System, RigidParts):
         self.dext = np.zeros((3, 3))  # dF/dv (N s/m)
         self._body = Body(self.x, self.v, self.q, self.w, self._mass, self.inertia_body,
                           self.gravity)
-        self._wrench = Wrench(self.force, self.torque, self.kext, self.dext)
+        self.carried = np.zeros(4)  # [kg] of points tied to it this step (Wrench.carried)
+        self.carried_inertia = np.zeros((3, 3))  # kg m^2 of them about its centre, world
+        self._wrench = Wrench(self.force, self.torque, self.kext, self.dext, self.carried,
+                              self.carried_inertia)
         self._gx, self._gv = np.zeros(7), np.zeros(7)
         self.surface = surface
         self.color = None  # linear RGB as drawn, or (n,3) one per surface vertex
@@ -72,13 +75,17 @@ class RigidBody(System, RigidParts):
         self.torque[:] = 0.0
         self.kext[:] = 0.0
         self.dext[:] = 0.0
+        self.carried[:] = 0.0
+        self.carried_inertia[:] = 0.0
 
-    def add_wrench(self, force, torque=None, point=None, dfdx=None, dfdv=None):
+    def add_wrench(self, force, torque=None, point=None, dfdx=None, dfdv=None, carried=None):
         """Add a force (N) at a world point (m; default the centre) and an extra torque (N m).
 
         dfdx (N/m) and dfdv (N s/m) are the force's 3x3 Jacobians with respect to the body's
         position and velocity; with them a stiff force (a floor contact) is integrated
-        implicitly and stays stable at the body's step."""
+        implicitly and stays stable at the body's step. carried: (mass kg, inertia (3,3)
+        kg m^2 about the centre, world axes) of points tied to the body that it accelerates
+        with itself over the step (``SegmentAttachment(carry=True)``)."""
         f = np.asarray(force, dtype=float)
         self.force += f
         if point is not None:
@@ -89,6 +96,9 @@ class RigidBody(System, RigidParts):
             self.kext += dfdx
         if dfdv is not None:
             self.dext += dfdv
+        if carried is not None:
+            self.carried[0] += carried[0]
+            self.carried_inertia += carried[1]
 
     def step(self, h):
         rigid_step(self._body, self._wrench, h)
@@ -119,8 +129,9 @@ class RigidBody(System, RigidParts):
     def centre_of_mass(self):
         return self.x
 
-    def add_part_wrench(self, part, force, torque=None, point=None, dfdx=None, dfdv=None):
-        self.add_wrench(force, torque, point, dfdx, dfdv)
+    def add_part_wrench(self, part, force, torque=None, point=None, dfdx=None, dfdv=None,
+                        carried=None):
+        self.add_wrench(force, torque, point, dfdx, dfdv, carried)
 
     def shapes(self):
         if self.surface is None:

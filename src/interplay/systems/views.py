@@ -126,7 +126,8 @@ class RigidParts(ABC):
 
     def add_part_wrench(self, part, force, torque=None, point=None, dfdx=None, dfdv=None):
         """Add a force (N) at a world point to a part (see BodiesView.apply); systems that
-        cannot be pushed ignore it."""
+        cannot be pushed ignore it. A system that can carry points tied to it (a free rigid
+        body) also takes ``carried`` (see BodiesView.apply)."""
 
 
 class BodiesView(_View):
@@ -181,13 +182,21 @@ class BodiesView(_View):
         """(3,) m: the whole system's centre of mass (torques in force logs are about it)."""
         return self.system.centre_of_mass()
 
-    def apply(self, part: int, force, torque=None, point=None, dfdx=None, dfdv=None) -> None:
+    def apply(self, part: int, force, torque=None, point=None, dfdx=None, dfdv=None,
+              carried=None) -> None:
         """Add a force (N) at a world point (m; default the part's centre of mass) and an extra
         torque (N m) to a part; dfdx, dfdv (3,3) the force's Jacobians with respect to the
-        part's position and velocity (a free rigid body integrates a stiff force with them).
-        Ignored when the system cannot be pushed."""
-        if self.movable:
+        part's position and velocity (a free rigid body integrates a stiff force with them);
+        carried: (mass kg, inertia (3,3) kg m^2 about the part's centre of mass, world axes)
+        of points tied to the part that it carries over the step (their other forces being
+        in force and torque; only systems that take it: a free rigid body). Ignored when the
+        system cannot be pushed."""
+        if not self.movable:
+            return
+        if carried is None:
             self.system.add_part_wrench(part, force, torque, point, dfdx, dfdv)
+        else:
+            self.system.add_part_wrench(part, force, torque, point, dfdx, dfdv, carried=carried)
 
 
 class ShapeView(_View):

@@ -8,19 +8,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, require_nonnegative
+from ..errors import ParameterError, require_nonnegative, require_positive
 from ..kernels import wind as K
 from .static import Stateless
 
 KINDS = {"uniform": K.UNIFORM, "source": K.SOURCE, "sink": K.SOURCE, "vortex": K.VORTEX,
-         "turbulence": K.TURBULENCE}
+         "turbulence": K.TURBULENCE, "boundary_layer": K.BOUNDARY_LAYER}
 TURBULENCE_MODES = 12  # Fourier modes of a turbulence primitive
 
 
 @dataclass(frozen=True)
 class FlowPrimitive:
-    """One primitive. kind: uniform | source | sink | vortex | turbulence (formulas in
-    ``kernels.wind``).
+    """One primitive. kind: uniform | source | sink | vortex | turbulence | boundary_layer
+    (formulas in ``kernels.wind``).
 
     position (m) of the centre at t = 0; axis: the flow direction (uniform) or the vortex
     axis (normalized here); strength: U m/s, q m^3/s (a sink draws in q), Gamma m^2/s, or the
@@ -31,6 +31,9 @@ class FlowPrimitive:
     relative amplitude of the strength's fluctuation, gust_period (s) its main period and
     phase (rad) its offset, so several primitives need not gust in step. With a ``path``,
     position and axis are in the path's moving frame (x forward, z up) and ride along it.
+    A boundary_layer is the wind over the ground at position's height: strength (m/s) is its
+    speed at ``height`` (m) above that ground, along axis (horizontal), growing with height by
+    the logarithmic law of the surface layer with roughness length ``core`` (m).
     """
     kind: str = "uniform"
     position: tuple = (0.0, 0.0, 0.0)
@@ -42,6 +45,7 @@ class FlowPrimitive:
     gust_period: float = 3.0
     phase: float = 0.0
     path: object = None
+    height: float = 10.0
 
     def checked(self, owner: str) -> "FlowPrimitive":
         if self.kind not in KINDS:
@@ -53,6 +57,10 @@ class FlowPrimitive:
                                  f"{self.axis}")
         for name, unit in (("core", "m"), ("gust", ""), ("gust_period", "s")):
             require_nonnegative(owner, f"{self.kind} {name}", getattr(self, name), unit)
+        if self.kind == "boundary_layer":
+            require_positive(owner, "boundary_layer core (roughness length)", self.core, "m")
+            require_positive(owner, "boundary_layer height (reference height)", self.height,
+                             "m")
         if self.gust_period == 0.0 and self.gust > 0.0:
             raise ParameterError(f"{owner}: a gusting {self.kind} needs gust_period > 0 s")
         if not math.isfinite(self.strength):
@@ -117,6 +125,8 @@ class WindField(Stateless):
             axis[q] = a
             kind[q] = KINDS[p.kind]
             strength[q] = (-1.0 if p.kind == "sink" else 1.0) * p.strength * p.gust_factor(t)
+            if p.kind == "boundary_layer":  # the kernel's profile is ln(1 + z/z0)
+                strength[q] /= math.log1p(p.height / p.core)
             core[q] = p.core
         return kind, centre, axis, strength, core
 

@@ -1,0 +1,217 @@
+"""Kite designs as geometry: the sail's mesh and which of its points lie on the frame, the
+frame's spars, the bridle's legs and towing points, and where the tail hangs from.
+
+Kite coordinates (m): x along the spine towards the nose, z out of the sail on its windward
+face (towards the bridle and the flyer), y = z x x. A design is a plain frozen dataclass;
+``geometry(design)`` turns it into a ``KiteGeometry`` (arrays only: the systems are built
+from it in ``scenes/kite_parts.py``).
+
+Designs (traditional proportions, e.g. Pelham, *The Penguin Book of Kites*, 1976):
+* ``DiamondParams``: the flat two-stick kite: a spine and a cross spar a quarter of the way
+  down it, the sail tied along both; a two-leg bridle from the spine; flown with a tail.
+* ``DeltaParams``: a delta wing: a spine, two leading-edge spars swept back from the nose with
+  a little dihedral (the wings bent back out of the spine's plane) and a spreader behind the
+  sail; the sail is tied along the spine and the leading edges, its trailing edge is free.
+* ``SledParams``... see the class docstrings for each design.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError, require_positive
+
+
+@dataclass(frozen=True)
+class SparParams:
+    """The frame's spars: radius (m) and density (kg/m^3) of a solid rod (a wooden dowel:
+    ~600-700; a carbon rod: ~1600); the frame is a rigid body of their masses."""
+    radius: float = 0.004
+    density: float = 650.0
+
+
+@dataclass(frozen=True)
+class DiamondParams:
+    """The flat diamond (two-stick) kite. length (m) of the spine; span (m) of the cross spar,
+    which crosses the spine at cross (fraction of the spine from the nose); the bridle's upper
+    and lower legs start on the spine at bridle (fractions from the nose) and meet at the
+    towing point, tow (fraction from the nose, projected on the spine) and tow_height (m) in
+    front of the sail; the tail hangs from the spine's foot."""
+    length: float = 1.0
+    span: float = 0.85
+    cross: float = 0.25
+    bridle: tuple = (0.04, 0.78)
+    tow: float = 0.36
+    tow_height: float = 0.32
+    spars: SparParams = SparParams()
+
+
+@dataclass(frozen=True)
+class DeltaParams:
+    """A delta. span (m) between the wingtips; length (m) of the spine; sweep (m): how far
+    back from the nose (along the spine) the wingtips are; dihedral (deg): each leading edge
+    bent back out of the spine's plane; spreader (fraction of each leading edge from the
+    nose): where the spreader spar joins them; bridle (fractions of the spine from the nose)
+    where the legs start, meeting at tow (fraction) and tow_height (m) in front of the sail."""
+    span: float = 1.6
+    length: float = 0.8
+    sweep: float = 0.6
+    dihedral: float = 10.0
+    spreader: float = 0.55
+    bridle: tuple = (0.12, 0.82)
+    tow: float = 0.42
+    tow_height: float = 0.30
+    spars: SparParams = SparParams(radius=0.003, density=1600.0)
+
+
+@dataclass
+class KiteGeometry:
+    """A design in kite coordinates (m). sail (n,3) and triangles (m,3): the sail's mesh;
+    ties: indices of sail points on the frame; spars: (s, 2, 3) ends of each spar, with
+    radius (m) and density (kg/m^3); bridles: per flying line, the (k,3) frame points its
+    legs start from and its towing point (3,); tail_root (3,): where the tail hangs from;
+    keel: unit vector of the windward normal (z)."""
+    sail: np.ndarray
+    triangles: np.ndarray
+    ties: np.ndarray
+    spars: np.ndarray
+    spar_radius: float
+    spar_density: float
+    bridles: list = field(default_factory=list)
+    tail_root: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+
+def subdivided(corners, n: int):
+    """A mesh of triangles (t,3,3) corner points, each cut into n^2 similar triangles (n cuts
+    per edge), with points shared along common edges welded: (vertices (v,3), triangles)."""
+    verts, tris, index = [], [], {}
+
+    def vid(p):
+        key = tuple(np.round(p, 9))
+        if key not in index:
+            index[key] = len(verts)
+            verts.append(p)
+        return index[key]
+
+    for a, b, c in np.asarray(corners, dtype=float):
+        grid = {(i, j): vid(a + (b - a) * i / n + (c - a) * j / n)
+                for i in range(n + 1) for j in range(n + 1 - i)}
+        for i in range(n):
+            for j in range(n - i):
+                tris.append((grid[i, j], grid[i + 1, j], grid[i, j + 1]))
+                if i + j < n - 1:
+                    tris.append((grid[i + 1, j], grid[i + 1, j + 1], grid[i, j + 1]))
+    return np.array(verts), np.array(tris, dtype=np.int64)
+
+
+def on_segments(points, segments, tol=1e-7):
+    """Indices of points (n,3) lying on any of the segments (s,2,3), within tol (m)."""
+    p = np.asarray(points, float)
+    hit = np.zeros(len(p), dtype=bool)
+    for a, b in np.asarray(segments, float):
+        d = b - a
+        s = np.clip((p - a) @ d / (d @ d), 0.0, 1.0)
+        hit |= np.linalg.norm(p - (a + s[:, None] * d), axis=1) < tol
+    return np.flatnonzero(hit)
+
+
+def _fraction(owner, name, value):
+    v = float(value)
+    if not 0.0 <= v <= 1.0:
+        raise ParameterError(f"{owner}: {name} must be a fraction in [0, 1], got {value!r}")
+    return v
+
+
+def _bridle(owner, spine_top, spine_foot, starts, tow, height):
+    """Bridle legs from points on the spine (fractions from the top) to a towing point at
+    fraction tow and height (m) in front of the sail (+z)."""
+    top, foot = np.asarray(spine_top, float), np.asarray(spine_foot, float)
+    legs = np.array([top + _fraction(owner, "bridle", f) * (foot - top) for f in starts])
+    towing = top + _fraction(owner, "tow", tow) * (foot - top)
+    towing = towing + np.array([0.0, 0.0, require_positive(owner, "tow_height", height, "m")])
+    return legs, towing
+
+
+def diamond(p: DiamondParams, n: int = 8) -> KiteGeometry:
+    """The diamond: four sail triangles around the spars' crossing, tied along both spars."""
+    L = require_positive("diamond", "length", p.length, "m")
+    S = require_positive("diamond", "span", p.span, "m")
+    c = _fraction("diamond", "cross", p.cross)
+    nose, foot = np.array([c * L, 0.0, 0.0]), np.array([-(1.0 - c) * L, 0.0, 0.0])
+    left, right = np.array([0.0, S / 2, 0.0]), np.array([0.0, -S / 2, 0.0])
+    o = np.zeros(3)
+    v, t = subdivided([(o, nose, left), (o, left, foot), (o, foot, right), (o, right, nose)], n)
+    spars = np.array([(nose, foot), (left, right)])
+    legs, towing = _bridle("diamond", nose, foot, p.bridle, p.tow, p.tow_height)
+    return KiteGeometry(v, t, on_segments(v, spars), spars, p.spars.radius, p.spars.density,
+                        [(legs, towing)], foot.copy())
+
+
+def delta(p: DeltaParams, n: int = 8) -> KiteGeometry:
+    """The delta: two sail triangles (nose, wingtip, spine's foot) meeting along the spine,
+    tied along the spine and the leading edges; the spreader joins the leading edges behind
+    the sail."""
+    S = require_positive("delta", "span", p.span, "m")
+    L = require_positive("delta", "length", p.length, "m")
+    sweep = require_positive("delta", "sweep", p.sweep, "m")
+    g = math.radians(p.dihedral)
+    if not 0.0 <= p.dihedral < 45.0:
+        raise ParameterError(f"delta: dihedral must be in [0, 45) deg, got {p.dihedral!r}")
+    nose, foot = np.zeros(3), np.array([-L, 0.0, 0.0])
+    half = S / 2
+    left = np.array([-sweep, half * math.cos(g), -half * math.sin(g)])
+    right = left * [1.0, -1.0, 1.0]
+    v, t = subdivided([(nose, left, foot), (nose, foot, right)], n)
+    s = _fraction("delta", "spreader", p.spreader)
+    spars = np.array([(nose, foot), (nose, left), (nose, right), (s * left, s * right)])
+    legs, towing = _bridle("delta", nose, foot, p.bridle, p.tow, p.tow_height)
+    return KiteGeometry(v, t, on_segments(v, spars[:3]), spars, p.spars.radius,
+                        p.spars.density, [(legs, towing)], foot.copy())
+
+
+# --- the frame as a rigid body: mass, centre of mass, principal axes -------------------------
+@dataclass
+class FrameInertia:
+    """mass (kg), centre (3,) in kite coordinates (m), principal moments (3,) (kg m^2) and
+    axes: the rotation (3,3) whose columns are the principal axes in kite coordinates."""
+    mass: float
+    centre: np.ndarray
+    moments: np.ndarray
+    axes: np.ndarray
+
+
+def frame_inertia(spars, radius: float, density: float) -> FrameInertia:
+    """Solid round rods: each of mass rho pi r^2 l, inertia m r^2 / 2 about its axis and
+    m (3 r^2 + l^2) / 12 across it about its middle, moved to the common centre of mass
+    (parallel axes)."""
+    r = require_positive("frame", "spar radius", radius, "m")
+    rho = require_positive("frame", "spar density", density, "kg/m^3")
+    a, b = np.asarray(spars, float)[:, 0], np.asarray(spars, float)[:, 1]
+    ln = np.linalg.norm(b - a, axis=1)
+    m = rho * math.pi * r * r * ln
+    mid = 0.5 * (a + b)
+    c = (m[:, None] * mid).sum(0) / m.sum()
+    inertia = np.zeros((3, 3))
+    for mk, lk, u, d in zip(m, ln, (b - a) / ln[:, None], mid - c):
+        uu = np.outer(u, u)
+        inertia += mk * r * r / 2 * uu + mk * (3 * r * r + lk * lk) / 12 * (np.eye(3) - uu)
+        inertia += mk * ((d @ d) * np.eye(3) - np.outer(d, d))
+    moments, axes = np.linalg.eigh(inertia)
+    if np.linalg.det(axes) < 0:
+        axes[:, 2] *= -1.0
+    return FrameInertia(float(m.sum()), c, moments, axes)
+
+
+def spar_mesh(spars, radius: float, frame: FrameInertia, resolution: int = 6):
+    """The spars as closed tubes (vertices (v,3) in the frame's principal body frame,
+    triangles): what the frame looks like."""
+    from .anthropometry import segment_mesh
+    verts, tris = [], []
+    for a, b in np.asarray(spars, float):
+        v, t = segment_mesh(("capsule", radius, (a - frame.centre) @ frame.axes,
+                             (b - frame.centre) @ frame.axes), resolution)
+        tris.append(t + sum(len(x) for x in verts))
+        verts.append(v)
+    return np.concatenate(verts), np.concatenate(tris)
