@@ -28,7 +28,7 @@ from ..errors import ParameterError, require_positive
 class SparParams:
     """The frame's spars: radius (m) and density (kg/m^3) of a solid rod (a wooden dowel:
     ~600-700; a carbon rod: ~1600); the frame is a rigid body of their masses."""
-    radius: float = 0.004
+    radius: float = 0.003
     density: float = 650.0
 
 
@@ -38,10 +38,12 @@ class DiamondParams:
     which crosses the spine at cross (fraction of the spine from the nose); the bridle's upper
     and lower legs start on the spine at bridle (fractions from the nose) and meet at the
     towing point, tow (fraction from the nose, projected on the spine) and tow_height (m) in
-    front of the sail; the tail hangs from the spine's foot."""
+    front of the sail; dihedral (deg): the cross spar bowed back so that each wingtip is
+    this far out of the spine's plane; the tail hangs from the spine's foot."""
     length: float = 1.0
     span: float = 0.85
     cross: float = 0.25
+    dihedral: float = 0.0
     bridle: tuple = (0.04, 0.78)
     tow: float = 0.36
     tow_height: float = 0.32
@@ -66,6 +68,33 @@ class DeltaParams:
     spars: SparParams = SparParams(radius=0.003, density=1600.0)
 
 
+@dataclass(frozen=True)
+class StuntParams:
+    """A two-line stunt delta. span (m) between the wingtips; length (m) of the spine; sweep
+    (m): how far back from the nose the wingtips are; dihedral (deg); spreader (fraction of
+    each leading edge from the nose): the upper spreader; lower (fraction of the spine and of
+    each leading edge): the lower spreaders' ends. Each side's bridle has three legs meeting
+    at that side's towing point (tow: fraction of the spine from the nose, projected;
+    tow_side (m) off the spine; tow_height (m) in front of the sail): the upper leg from the
+    spine at upper (fraction from the nose), the lower leg from the middle of that side's
+    lower spreader and the outer leg from where it meets the leading edge. The upper leg
+    pulls its end out towards the towing point ahead of the frame's centre of mass and the
+    other two pull theirs in behind it, so a pull on one line turns the kite's nose to that
+    side as it rolls it (its force tilting to that side): pull left to turn left."""
+    span: float = 2.2
+    length: float = 0.85
+    sweep: float = 0.55
+    dihedral: float = 8.0
+    spreader: float = 0.45
+    lower: float = 0.7
+    bridle: tuple = (0.12, 0.78, 0.62)
+    tow: float = 0.44
+    tow_side: float = 0.22
+    tow_height: float = 0.6
+    ballast: float = 0.0
+    spars: SparParams = SparParams(radius=0.003, density=900.0)
+
+
 @dataclass
 class KiteGeometry:
     """A design in kite coordinates (m). sail (n,3) and triangles (m,3): the sail's mesh;
@@ -81,6 +110,7 @@ class KiteGeometry:
     spar_density: float
     bridles: list = field(default_factory=list)
     tail_root: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    ballast: tuple = ()  # (point (3,), mass kg): weights fixed to the frame
 
 
 def subdivided(corners, n: int):
@@ -124,6 +154,12 @@ def _fraction(owner, name, value):
     return v
 
 
+def _dihedral(owner, deg):
+    if not 0.0 <= deg < 45.0:
+        raise ParameterError(f"{owner}: dihedral must be in [0, 45) deg, got {deg!r}")
+    return math.radians(deg)
+
+
 def _bridle(owner, spine_top, spine_foot, starts, tow, height):
     """Bridle legs from points on the spine (fractions from the top) to a towing point at
     fraction tow and height (m) in front of the sail (+z)."""
@@ -139,11 +175,13 @@ def diamond(p: DiamondParams, n: int = 8) -> KiteGeometry:
     L = require_positive("diamond", "length", p.length, "m")
     S = require_positive("diamond", "span", p.span, "m")
     c = _fraction("diamond", "cross", p.cross)
+    g = _dihedral("diamond", p.dihedral)
     nose, foot = np.array([c * L, 0.0, 0.0]), np.array([-(1.0 - c) * L, 0.0, 0.0])
-    left, right = np.array([0.0, S / 2, 0.0]), np.array([0.0, -S / 2, 0.0])
+    left = np.array([0.0, S / 2 * math.cos(g), -S / 2 * math.sin(g)])
+    right = left * [1.0, -1.0, 1.0]
     o = np.zeros(3)
     v, t = subdivided([(o, nose, left), (o, left, foot), (o, foot, right), (o, right, nose)], n)
-    spars = np.array([(nose, foot), (left, right)])
+    spars = np.array([(nose, foot), (left, o), (o, right)])
     legs, towing = _bridle("diamond", nose, foot, p.bridle, p.tow, p.tow_height)
     return KiteGeometry(v, t, on_segments(v, spars), spars, p.spars.radius, p.spars.density,
                         [(legs, towing)], foot.copy())
@@ -156,9 +194,7 @@ def delta(p: DeltaParams, n: int = 8) -> KiteGeometry:
     S = require_positive("delta", "span", p.span, "m")
     L = require_positive("delta", "length", p.length, "m")
     sweep = require_positive("delta", "sweep", p.sweep, "m")
-    g = math.radians(p.dihedral)
-    if not 0.0 <= p.dihedral < 45.0:
-        raise ParameterError(f"delta: dihedral must be in [0, 45) deg, got {p.dihedral!r}")
+    g = _dihedral("delta", p.dihedral)
     nose, foot = np.zeros(3), np.array([-L, 0.0, 0.0])
     half = S / 2
     left = np.array([-sweep, half * math.cos(g), -half * math.sin(g)])
@@ -169,6 +205,39 @@ def delta(p: DeltaParams, n: int = 8) -> KiteGeometry:
     legs, towing = _bridle("delta", nose, foot, p.bridle, p.tow, p.tow_height)
     return KiteGeometry(v, t, on_segments(v, spars[:3]), spars, p.spars.radius,
                         p.spars.density, [(legs, towing)], foot.copy())
+
+
+def stunt(p: StuntParams, n: int = 8) -> KiteGeometry:
+    """The stunt delta: a delta's sail and leading edges, an upper spreader and two lower
+    spreaders from the spine to the leading edges; two bridles, left (+y) and right, each
+    ending at its own towing point where its flying line is tied."""
+    S = require_positive("stunt", "span", p.span, "m")
+    L = require_positive("stunt", "length", p.length, "m")
+    sweep = require_positive("stunt", "sweep", p.sweep, "m")
+    g = _dihedral("stunt", p.dihedral)
+    nose, foot = np.zeros(3), np.array([-L, 0.0, 0.0])
+    left = np.array([-sweep, S / 2 * math.cos(g), -S / 2 * math.sin(g)])
+    right = left * [1.0, -1.0, 1.0]
+    v, t = subdivided([(nose, left, foot), (nose, foot, right)], n)
+    s = _fraction("stunt", "spreader", p.spreader)
+    lo = _fraction("stunt", "lower", p.lower)
+    spine_lo = lo * foot
+    spars = np.array([(nose, foot), (nose, left), (nose, right), (s * left, s * right),
+                      (spine_lo, lo * left), (spine_lo, lo * right)])
+    side = require_positive("stunt", "tow_side", p.tow_side, "m")
+    tow = _fraction("stunt", "tow", p.tow) * foot + [0.0, 0.0, require_positive(
+        "stunt", "tow_height", p.tow_height, "m")]
+    if len(p.bridle) != 3:
+        raise ParameterError(f"stunt: bridle needs 3 fractions (upper and lower on the spine, "
+                             f"outer on the leading edge), got {p.bridle!r}")
+    up, low, out = (_fraction("stunt", "bridle", f) for f in p.bridle)
+    bridles = []
+    for tip, sign in ((left, 1.0), (right, -1.0)):
+        legs = np.array([up * foot, low * foot, out * tip])
+        bridles.append((legs, tow + [0.0, sign * side, 0.0]))
+    ballast = ((foot.copy(), float(p.ballast)),) if p.ballast > 0 else ()
+    return KiteGeometry(v, t, on_segments(v, spars[:3]), spars, p.spars.radius,
+                        p.spars.density, bridles, foot.copy(), ballast)
 
 
 # --- the frame as a rigid body: mass, centre of mass, principal axes -------------------------
@@ -182,26 +251,30 @@ class FrameInertia:
     axes: np.ndarray
 
 
-def frame_inertia(spars, radius: float, density: float) -> FrameInertia:
+def frame_inertia(spars, radius: float, density: float, ballast=()) -> FrameInertia:
     """Solid round rods: each of mass rho pi r^2 l, inertia m r^2 / 2 about its axis and
     m (3 r^2 + l^2) / 12 across it about its middle, moved to the common centre of mass
-    (parallel axes)."""
+    (parallel axes); ballast: (point, mass kg) point masses fixed to the frame."""
     r = require_positive("frame", "spar radius", radius, "m")
     rho = require_positive("frame", "spar density", density, "kg/m^3")
     a, b = np.asarray(spars, float)[:, 0], np.asarray(spars, float)[:, 1]
     ln = np.linalg.norm(b - a, axis=1)
     m = rho * math.pi * r * r * ln
     mid = 0.5 * (a + b)
-    c = (m[:, None] * mid).sum(0) / m.sum()
+    pm = np.array([w for _, w in ballast], float)
+    pp = np.array([q for q, _ in ballast], float).reshape(-1, 3)
+    c = ((m[:, None] * mid).sum(0) + (pm[:, None] * pp).sum(0)) / (m.sum() + pm.sum())
     inertia = np.zeros((3, 3))
     for mk, lk, u, d in zip(m, ln, (b - a) / ln[:, None], mid - c):
         uu = np.outer(u, u)
         inertia += mk * r * r / 2 * uu + mk * (3 * r * r + lk * lk) / 12 * (np.eye(3) - uu)
         inertia += mk * ((d @ d) * np.eye(3) - np.outer(d, d))
+    for mk, q in zip(pm, pp - c):
+        inertia += mk * ((q @ q) * np.eye(3) - np.outer(q, q))
     moments, axes = np.linalg.eigh(inertia)
     if np.linalg.det(axes) < 0:
         axes[:, 2] *= -1.0
-    return FrameInertia(float(m.sum()), c, moments, axes)
+    return FrameInertia(float(m.sum() + pm.sum()), c, moments, axes)
 
 
 def spar_mesh(spars, radius: float, frame: FrameInertia, resolution: int = 6):

@@ -36,8 +36,44 @@ from ..interactions.attachment import AttachmentParams, SegmentAttachment
 from ..interactions.ground import GroundContact, GroundParams
 from ..systems.rigid import RigidBody
 from ..systems.springmass import SpringNetwork, Springs
+from ..systems.wind import FlowPrimitive, WindField
 
 FLY_ELEVATION = 40.0  # deg: the lowest line elevation at which a kite is said to fly
+
+
+@dataclass(frozen=True)
+class KiteWind:
+    """The wind over open ground: speed (m/s) at the reference height (m) growing with height
+    by the logarithmic profile of roughness length roughness (m; 0.03: short grass, open
+    country), from heading (deg from +x, counter-clockwise); gusting by +-gust of it with
+    main period gust_period (s); carrying turbulence of rms turbulence (share of speed, per
+    component) in eddies of scale (m); seed picks the gusts' phase and the eddies (one wind
+    per seed)."""
+    speed: float = 6.0
+    height: float = 10.0
+    roughness: float = 0.03
+    heading: float = 0.0
+    gust: float = 0.2
+    gust_period: float = 7.0
+    turbulence: float = 0.1
+    scale: float = 8.0
+    seed: int = 0
+
+
+def kite_wind(w: KiteWind) -> WindField:
+    """The boundary-layer wind, gusting, with the turbulence it carries (frozen eddies moving
+    with the wind at the reference height's speed)."""
+    h = math.radians(w.heading)
+    along = (math.cos(h), math.sin(h), 0.0)
+    phase = (1.618034 * int(w.seed)) % (2.0 * math.pi)
+    prims = [FlowPrimitive("boundary_layer", axis=along, strength=w.speed, core=w.roughness,
+                           height=w.height, gust=w.gust, gust_period=w.gust_period,
+                           phase=phase)]
+    if w.turbulence > 0.0:
+        prims.append(FlowPrimitive("turbulence", strength=w.turbulence * w.speed, core=w.scale,
+                                   phase=0.5 + int(w.seed),
+                                   velocity=tuple(w.speed * np.asarray(along))))
+    return WindField("wind", prims)
 
 
 @dataclass(frozen=True)
@@ -131,7 +167,7 @@ def _rotation_to_quat(R) -> np.ndarray:
 def frame_body(name: str, g: KiteGeometry, position, rotation, dt: float) -> RigidBody:
     """The spars as one rigid body placed so that kite coordinates map to the world by
     ``rotation`` (3,3) about ``position`` (m, the kite origin)."""
-    fi = frame_inertia(g.spars, g.spar_radius, g.spar_density)
+    fi = frame_inertia(g.spars, g.spar_radius, g.spar_density, g.ballast)
     body = RigidBody(name, fi.mass, fi.moments, dt,
                      position=np.asarray(position, float) + rotation @ fi.centre,
                      surface=spar_mesh(g.spars, g.spar_radius, fi))
@@ -212,16 +248,23 @@ def line_network(name, bridles, hands, p: LineParams, frame_points):
     return net, index
 
 
-def tail_network(name, root, direction, p: TailParams, color):
+def tail_network(name, root, direction, p: TailParams, color, ground=None, along=(1, 0, 0)):
     """The tail from ``root`` (world, m) along ``direction``: a chain of tension-only string
-    segments with a bow every ``bow_every`` points counted from the free end."""
+    segments with a bow every ``bow_every`` points counted from the free end. Where it would
+    pass below ``ground`` (a height, m) it lies on it instead, running on ``along``."""
     n = int(p.segments)
     if n < 1:
         raise ParameterError(f"{name}: tail segments must be >= 1, got {p.segments!r}")
     L = require_positive(name, "tail length", p.length, "m")
     d = np.asarray(direction, float)
     d = d / np.linalg.norm(d)
-    x = np.asarray(root, float) + np.outer(np.linspace(0.0, L, n + 1), d)
+    s = np.linspace(0.0, L, n + 1)
+    x = np.asarray(root, float) + np.outer(s, d)
+    if ground is not None and d[2] < 0.0 and x[-1, 2] < ground + 0.01:
+        drop = (x[0, 2] - ground - 0.01) / -d[2]  # length hanging before it reaches the ground
+        flat = s > drop
+        a = np.asarray(along, float) / np.linalg.norm(along)
+        x[flat] = (np.asarray(root, float) + drop * d) + np.outer(s[flat] - drop, a)
     seg = L / n
     m = np.full(n + 1, require_positive(name, "tail density", p.density, "kg/m") * seg)
     m[[0, -1]] *= 0.5
@@ -267,15 +310,16 @@ def build_kite(scene, name: str, g: KiteGeometry, p: KiteParams, wind, ground, p
            CordDrag(f"{name}-air-line", wind, lines, p.cord_air),
            GroundContact(f"{name}-ground-sail", ground, sail, p.ground),
            GroundContact(f"{name}-ground-line", ground, lines, p.ground)]
-    if holder is not None:
+    if holder is not None:  # one tie per line: each one's force log is that line's pull
         body, parts = holder
-        its.append(SegmentAttachment(f"{name}-hand", body, lines,
-                                     [(end, part) for (_, _, end), part in zip(index, parts)],
-                                     params=p.line.ties, mode=mode))
+        its += [SegmentAttachment(f"{name}-{part}", body, lines, [(end, part)],
+                                  params=p.line.ties, mode=mode)
+                for (_, _, end), part in zip(index, parts)]
     tail, bows = None, np.zeros(0, np.int64)
     if p.tail.length > 0.0:
         root = world(g.tail_root)
-        tail, bows = tail_network(f"{name}-tail", root, -rotation[:, 0], p.tail, tail_color)
+        tail, bows = tail_network(f"{name}-tail", root, -rotation[:, 0], p.tail, tail_color,
+                                  ground.contact_view().height)
         scene.add(tail)
         its += [SegmentAttachment(f"{name}-tail-tie", frame, tail, [(0, frame.name)],
                                   _local(fi, g.tail_root[None]), p.tail.tie, mode),

@@ -1,0 +1,160 @@
+"""A stunt-kite pilot: watches the kite and moves the two handles as a person flies a two-line
+kite: pull one side to turn towards it, both hands together to hold. It reads the kite only
+through its frame's contact view (pose and velocity of a rigid part), like an interaction.
+
+Where the kite is: on the wind window, the quarter sphere of the lines' length downwind of the
+hands, by its azimuth phi (from the wind's direction, positive to the pilot's left) and
+elevation eps. Which way it flies: its heading chi, the direction its nose points within the
+window (0 up, +90 deg to the pilot's left), from the frame's orientation. Manoeuvres (a state
+machine over the flight):
+
+* ``hold``: park the kite at azimuth ``target`` (deg): the nose is steered towards the target
+  azimuth (heading -gain (phi - target), within +-hold_tilt) and the kite climbs to where it
+  rests, the window's top over that azimuth;
+* ``loop``: hold until ``start`` (s), then pull one side fully until the nose has turned a
+  full circle (the turn measured by integrating the heading's change), then hold again; one
+  loop every ``every`` seconds, turning left and right by turns;
+* ``figure8``: a loop one way straight into a loop the other way (the path draws an 8).
+
+The steering command u in [-1, 1] (positive: pull the left handle) moves the left handle back
+and the right one forward by u times ``throw`` (m) along the pilot's facing; the pilot's arms
+(``systems.pilot``) follow it with their own response time. The controller acts at
+``rate`` (Hz), a person's reaction cadence.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, require_positive
+
+MANOEUVRES = ("hold", "loop", "figure8")
+
+
+@dataclass(frozen=True)
+class StuntPilotParams:
+    """manoeuvre: hold | loop | figure8; start (s): when the first manoeuvre begins; every (s):
+    the time from one manoeuvre's start to the next; target (deg): the azimuth held between
+    manoeuvres; gain (-): heading per azimuth error when holding; hold_tilt (deg): the
+    largest heading used to hold; turn_gain (1/rad): steering per heading error; turn_damping
+    (s/rad): steering against the heading's rate of turn, so the nose settles; throw (m):
+    handle travel at full steering; rate (Hz): how often the pilot looks and acts."""
+    manoeuvre: str = "loop"
+    start: float = 8.0
+    every: float = 10.0
+    target: float = 0.0
+    gain: float = 2.0
+    hold_tilt: float = 30.0
+    turn_gain: float = 1.5
+    turn_damping: float = 0.3
+    throw: float = 0.2
+    rate: float = 20.0
+
+
+def window_coordinates(position, centre):
+    """(azimuth phi, elevation eps) (rad) of ``position`` seen from ``centre`` (m), the wind
+    along +x: phi positive towards +y."""
+    r = np.asarray(position, float) - np.asarray(centre, float)
+    return math.atan2(r[1], r[0]), math.atan2(r[2], math.hypot(r[0], r[1]))
+
+
+def heading(nose, phi, eps):
+    """The nose's direction (rad) in the window's tangent plane at (phi, eps): 0 up, +pi/2
+    towards increasing azimuth (the pilot's left)."""
+    up = np.array([-math.sin(eps) * math.cos(phi), -math.sin(eps) * math.sin(phi),
+                   math.cos(eps)])
+    left = np.array([-math.sin(phi), math.cos(phi), 0.0])
+    return math.atan2(float(nose @ left), float(nose @ up))
+
+
+def _wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class StuntPilot:
+    """The controller a ``Pilot`` asks for its handle targets. kite: the kite frame's contact
+    view (a BodiesView of one part); nose_axis: the kite's nose in that part's frame. It keeps
+    the manoeuvres it flew as ``log``: (kind, direction, start s, end s or None)."""
+
+    def __init__(self, kite_view, nose_axis, params: StuntPilotParams = StuntPilotParams()):
+        if params.manoeuvre not in MANOEUVRES:
+            raise ParameterError(f"pilot: unknown manoeuvre {params.manoeuvre!r}; choose one "
+                                 f"of {', '.join(MANOEUVRES)}")
+        self.p = params
+        self.kite = kite_view
+        self.nose_axis = np.asarray(nose_axis, float)
+        self.period = 1.0 / require_positive("pilot", "rate", params.rate, "Hz")
+        require_positive("pilot", "every", params.every, "s")
+        self.u = 0.0  # the steering held between looks
+        self.next = 0.0  # time (s) of the next look
+        self.turned = 0.0  # rad the nose has turned in the current loop
+        self.last = None  # the heading at the last look
+        self.state = 0  # 0: hold; +-1: looping left/right; +-2: first loop of an 8, left/right
+        self.count = 0  # manoeuvres started
+        self.log = []
+
+    # --- what the kite does -------------------------------------------------------------------
+    def observe(self, centre):
+        """(phi, eps, chi) of the kite now (rad)."""
+        pos, R = self.kite.poses()
+        phi, eps = window_coordinates(pos[0], centre)
+        return phi, eps, heading(R[0] @ self.nose_axis, phi, eps)
+
+    def targets(self, pilot, t):
+        """World positions (m) of the two handles at time t (s)."""
+        if t >= self.next - 1e-9:
+            self.next = t + self.period
+            self._decide(pilot, t)
+        forward = pilot.R0[:, 0] * np.array([1.0, 1.0, 0.0])
+        forward /= np.linalg.norm(forward)
+        off = self.u * self.p.throw * forward
+        return pilot.rest + np.array([-off, off])
+
+    def _decide(self, pilot, t):
+        phi, eps, chi = self.observe(pilot.rest.mean(axis=0))
+        rate = 0.0
+        if self.last is not None:
+            step = _wrap(chi - self.last)
+            self.turned += step
+            rate = step / self.period
+        self.last = chi
+        p = self.p
+        if self.state == 0 and p.manoeuvre != "hold" and t >= p.start + self.count * p.every:
+            sign = 1 if self.count % 2 == 0 else -1
+            self.state = sign * (2 if p.manoeuvre == "figure8" else 1)
+            self.turned = 0.0
+            self.count += 1
+            self.log.append([p.manoeuvre, sign, t, None])
+        if self.state != 0:
+            sign = 1 if self.state > 0 else -1
+            self.u = float(sign)
+            if sign * self.turned >= 2.0 * math.pi:
+                if abs(self.state) == 2:  # the 8's second loop, the other way
+                    self.state = -sign
+                    self.turned = 0.0
+                else:
+                    self.state = 0
+                    self.log[-1][3] = t
+            return
+        tilt = math.radians(p.hold_tilt)
+        want = float(np.clip(-p.gain * (phi - math.radians(p.target)), -tilt, tilt))
+        self.u = float(np.clip(p.turn_gain * _wrap(want - chi) - p.turn_damping * rate,
+                               -1.0, 1.0))
+
+    # --- memory, for checkpoints -----------------------------------------------------------------
+    def capture(self) -> dict:
+        log = np.array([[MANOEUVRES.index(k), s, a, np.nan if b is None else b]
+                        for k, s, a, b in self.log]).reshape(-1, 4)
+        return {"state": np.array([self.u, self.next, self.turned,
+                                   np.nan if self.last is None else self.last,
+                                   self.state, self.count]), "log": log}
+
+    def restore(self, snap: dict):
+        u, nxt, turned, last, state, count = snap["state"]
+        self.u, self.next, self.turned = float(u), float(nxt), float(turned)
+        self.last = None if math.isnan(last) else float(last)
+        self.state, self.count = int(state), int(count)
+        self.log = [[MANOEUVRES[int(k)], int(s), float(a), None if math.isnan(b) else float(b)]
+                    for k, s, a, b in snap["log"]]
