@@ -11,10 +11,12 @@ machine over the flight):
 * ``hold``: park the kite at azimuth ``target`` (deg): the nose is steered towards the target
   azimuth (heading -gain (phi - target), within +-hold_tilt) and the kite climbs to where it
   rests, the window's top over that azimuth;
-* ``loop``: hold until ``start`` (s), then pull one side fully until the nose has turned a
-  full circle (the turn measured by integrating the heading's change), then hold again; one
-  loop every ``every`` seconds, turning left and right by turns;
-* ``figure8``: a loop one way straight into a loop the other way (the path draws an 8).
+* ``loop``: from ``start`` (s), one loop every ``every`` seconds, to the left and the right by
+  turns, each begun once the kite is parked high (above ``ready`` deg of elevation): one side
+  is pulled fully until the nose has turned a full circle (the turn measured by integrating
+  the heading's change), then the kite is held again;
+* ``figure8``: a loop one way, the kite brought back up to where it began (``ready``), and a
+  loop the other way: two circles meeting at the top of the window, an eight.
 
 The steering command u in [-1, 1] (positive: pull the left handle) moves the left handle back
 and the right one forward by u times ``throw`` (m) along the pilot's facing; the pilot's arms
@@ -36,20 +38,25 @@ MANOEUVRES = ("hold", "loop", "figure8")
 @dataclass(frozen=True)
 class StuntPilotParams:
     """manoeuvre: hold | loop | figure8; start (s): when the first manoeuvre begins; every (s):
-    the time from one manoeuvre's start to the next; target (deg): the azimuth held between
+    the time from one manoeuvre's start to the next; ready (deg): the elevation a loop starts
+    from; target (deg): the azimuth held between
     manoeuvres; gain (-): heading per azimuth error when holding; hold_tilt (deg): the
     largest heading used to hold; turn_gain (1/rad): steering per heading error; turn_damping
     (s/rad): steering against the heading's rate of turn, so the nose settles; throw (m):
-    handle travel at full steering; rate (Hz): how often the pilot looks and acts."""
+    handle travel at full steering; brace (m): both handles drawn back during a manoeuvre (a
+    flyer leans back in a turn, keeping both lines taut); rate (Hz): how often the pilot looks
+    and acts."""
     manoeuvre: str = "loop"
     start: float = 8.0
-    every: float = 10.0
+    every: float = 12.0
+    ready: float = 40.0
     target: float = 0.0
     gain: float = 2.0
     hold_tilt: float = 30.0
-    turn_gain: float = 1.5
+    turn_gain: float = 0.8
     turn_damping: float = 0.3
     throw: float = 0.2
+    brace: float = 0.0
     rate: float = 20.0
 
 
@@ -67,6 +74,10 @@ def heading(nose, phi, eps):
                    math.cos(eps)])
     left = np.array([-math.sin(phi), math.cos(phi), 0.0])
     return math.atan2(float(nose @ left), float(nose @ up))
+
+
+HOLD, TURN, RECOVER = 0, 1, 2  # the pilot's phases: holding, turning a loop, climbing back
+SETTLED = math.radians(20.0)  # the nose is near enough straight up to begin a loop
 
 
 def _wrap(a):
@@ -89,9 +100,10 @@ class StuntPilot:
         require_positive("pilot", "every", params.every, "s")
         self.u = 0.0  # the steering held between looks
         self.next = 0.0  # time (s) of the next look
-        self.turned = 0.0  # rad the nose has turned in the current loop
+        self.turned = 0.0  # rad the nose has turned in the current turn
         self.last = None  # the heading at the last look
-        self.state = 0  # 0: hold; +-1: looping left/right; +-2: first loop of an 8, left/right
+        self.phase = HOLD
+        self.side = 1  # the side (+1: the pilot's left) the manoeuvre is on now
         self.count = 0  # manoeuvres started
         self.log = []
 
@@ -110,7 +122,8 @@ class StuntPilot:
         forward = pilot.R0[:, 0] * np.array([1.0, 1.0, 0.0])
         forward /= np.linalg.norm(forward)
         off = self.u * self.p.throw * forward
-        return pilot.rest + np.array([-off, off])
+        back = (self.p.brace if self.phase != HOLD else 0.0) * forward
+        return pilot.rest + np.array([-off - back, off - back])
 
     def _decide(self, pilot, t):
         phi, eps, chi = self.observe(pilot.rest.mean(axis=0))
@@ -121,27 +134,32 @@ class StuntPilot:
             rate = step / self.period
         self.last = chi
         p = self.p
-        if self.state == 0 and p.manoeuvre != "hold" and t >= p.start + self.count * p.every:
-            sign = 1 if self.count % 2 == 0 else -1
-            self.state = sign * (2 if p.manoeuvre == "figure8" else 1)
-            self.turned = 0.0
+        ready = eps >= math.radians(p.ready) and abs(chi) < SETTLED
+        if (self.phase == HOLD and p.manoeuvre != "hold" and ready
+                and t >= p.start + self.count * p.every):
+            self.side = 1 if self.count % 2 == 0 else -1
             self.count += 1
-            self.log.append([p.manoeuvre, sign, t, None])
-        if self.state != 0:
-            sign = 1 if self.state > 0 else -1
-            self.u = float(sign)
-            if sign * self.turned >= 2.0 * math.pi:
-                if abs(self.state) == 2:  # the 8's second loop, the other way
-                    self.state = -sign
-                    self.turned = 0.0
-                else:
-                    self.state = 0
+            self.log.append([p.manoeuvre, self.side, t, None])
+            self.phase, self.turned = TURN, 0.0
+        elif self.phase == RECOVER and ready:  # the eight's second loop, the other way
+            self.side, self.phase, self.turned = -self.side, TURN, 0.0
+        if self.phase == TURN:
+            self.u = float(self.side)
+            if self.side * self.turned >= 2.0 * math.pi:
+                eight = p.manoeuvre == "figure8" and self.side == self.log[-1][1]
+                self.phase = RECOVER if eight else HOLD
+                if not eight:
                     self.log[-1][3] = t
-            return
+            if self.phase == TURN:
+                return
         tilt = math.radians(p.hold_tilt)
-        want = float(np.clip(-p.gain * (phi - math.radians(p.target)), -tilt, tilt))
-        self.u = float(np.clip(p.turn_gain * _wrap(want - chi) - p.turn_damping * rate,
-                               -1.0, 1.0))
+        self._steer(float(np.clip(-p.gain * (phi - math.radians(p.target)), -tilt, tilt)),
+                    chi, rate)
+
+    def _steer(self, want, chi, rate):
+        """Steer the nose towards heading ``want`` (rad), damped by its rate of turn."""
+        self.u = float(np.clip(self.p.turn_gain * _wrap(want - chi)
+                               - self.p.turn_damping * rate, -1.0, 1.0))
 
     # --- memory, for checkpoints -----------------------------------------------------------------
     def capture(self) -> dict:
@@ -149,12 +167,12 @@ class StuntPilot:
                         for k, s, a, b in self.log]).reshape(-1, 4)
         return {"state": np.array([self.u, self.next, self.turned,
                                    np.nan if self.last is None else self.last,
-                                   self.state, self.count]), "log": log}
+                                   self.phase, self.side, self.count]), "log": log}
 
     def restore(self, snap: dict):
-        u, nxt, turned, last, state, count = snap["state"]
+        u, nxt, turned, last, phase, side, count = snap["state"]
         self.u, self.next, self.turned = float(u), float(nxt), float(turned)
         self.last = None if math.isnan(last) else float(last)
-        self.state, self.count = int(state), int(count)
+        self.phase, self.side, self.count = int(phase), int(side), int(count)
         self.log = [[MANOEUVRES[int(k)], int(s), float(a), None if math.isnan(b) else float(b)]
                     for k, s, a, b in snap["log"]]

@@ -12,7 +12,9 @@ Designs (traditional proportions, e.g. Pelham, *The Penguin Book of Kites*, 1976
 * ``DeltaParams``: a delta wing: a spine, two leading-edge spars swept back from the nose with
   a little dihedral (the wings bent back out of the spine's plane) and a spreader behind the
   sail; the sail is tied along the spine and the leading edges, its trailing edge is free.
-* ``SledParams``... see the class docstrings for each design.
+* ``RokkakuParams``: the Japanese six-sided kite: a spine and two cross spars near its ends,
+  bowed back; a hexagonal sail tied along all three.
+* ``StuntParams``: a two-line stunt delta with two bridles, one per flying line.
 """
 from __future__ import annotations
 
@@ -56,7 +58,10 @@ class DeltaParams:
     back from the nose (along the spine) the wingtips are; dihedral (deg): each leading edge
     bent back out of the spine's plane; spreader (fraction of each leading edge from the
     nose): where the spreader spar joins them; bridle (fractions of the spine from the nose)
-    where the legs start, meeting at tow (fraction) and tow_height (m) in front of the sail."""
+    where the legs start, meeting at tow (fraction) and tow_height (m) in front of the sail;
+    keel (m): the height of a triangular keel sewn along the spine between keel_span
+    (fractions from the nose), standing out in front of the sail (0: none): the fin that
+    keeps a delta's nose into the wind; ballast (kg): a weight at the spine's foot."""
     span: float = 1.6
     length: float = 0.8
     sweep: float = 0.6
@@ -64,8 +69,27 @@ class DeltaParams:
     spreader: float = 0.55
     bridle: tuple = (0.12, 0.82)
     tow: float = 0.42
-    tow_height: float = 0.30
-    spars: SparParams = SparParams(radius=0.003, density=1600.0)
+    tow_height: float = 0.45
+    keel: float = 0.0
+    keel_span: tuple = (0.2, 0.75)
+    ballast: float = 0.0
+    spars: SparParams = SparParams(radius=0.003, density=900.0)
+
+
+@dataclass(frozen=True)
+class RokkakuParams:
+    """The rokkaku. length (m) of the spine; span (m) of the two cross spars, which cross the
+    spine at spars (fractions from the top); dihedral (deg): the cross spars bowed back so
+    their tips are this far out of the spine's plane; bridle and tow, tow_height as the
+    diamond's."""
+    length: float = 1.2
+    span: float = 0.95
+    spars: tuple = (0.2, 0.8)
+    dihedral: float = 12.0
+    bridle: tuple = (0.1, 0.85)
+    tow: float = 0.42
+    tow_height: float = 0.45
+    rods: SparParams = SparParams(radius=0.003, density=650.0)
 
 
 @dataclass(frozen=True)
@@ -199,12 +223,39 @@ def delta(p: DeltaParams, n: int = 8) -> KiteGeometry:
     half = S / 2
     left = np.array([-sweep, half * math.cos(g), -half * math.sin(g)])
     right = left * [1.0, -1.0, 1.0]
-    v, t = subdivided([(nose, left, foot), (nose, foot, right)], n)
+    pieces = [(nose, left, foot), (nose, foot, right)]
+    if p.keel > 0.0:
+        k0, k1 = (_fraction("delta", "keel_span", f) * foot for f in p.keel_span)
+        pieces.append((k0, k1, 0.5 * (k0 + k1) + [0.0, 0.0, p.keel]))
+    v, t = subdivided(pieces, n)
     s = _fraction("delta", "spreader", p.spreader)
     spars = np.array([(nose, foot), (nose, left), (nose, right), (s * left, s * right)])
     legs, towing = _bridle("delta", nose, foot, p.bridle, p.tow, p.tow_height)
+    ballast = ((foot.copy(), float(p.ballast)),) if p.ballast > 0 else ()
     return KiteGeometry(v, t, on_segments(v, spars[:3]), spars, p.spars.radius,
-                        p.spars.density, [(legs, towing)], foot.copy())
+                        p.spars.density, [(legs, towing)], foot.copy(), ballast)
+
+
+def rokkaku(p: RokkakuParams, n: int = 5) -> KiteGeometry:
+    """The rokkaku: the hexagon cut into triangles along its spine and cross spars, tied along
+    all three."""
+    L = require_positive("rokkaku", "length", p.length, "m")
+    S = require_positive("rokkaku", "span", p.span, "m")
+    g = _dihedral("rokkaku", p.dihedral)
+    if len(p.spars) != 2:
+        raise ParameterError(f"rokkaku: spars needs 2 fractions, got {p.spars!r}")
+    f1, f2 = sorted(_fraction("rokkaku", "spars", f) for f in p.spars)
+    top, foot = np.zeros(3), np.array([-L, 0.0, 0.0])
+    c1, c2 = f1 * foot, f2 * foot
+    tip = np.array([0.0, S / 2 * math.cos(g), -S / 2 * math.sin(g)])
+    ul, ll = c1 + tip, c2 + tip
+    ur, lr = ul * [1.0, -1.0, 1.0], ll * [1.0, -1.0, 1.0]
+    v, t = subdivided([(top, ul, c1), (top, c1, ur), (c1, ul, ll), (c1, ll, c2),
+                       (c1, c2, lr), (c1, lr, ur), (c2, ll, foot), (c2, foot, lr)], n)
+    spars = np.array([(top, foot), (ul, c1), (c1, ur), (ll, c2), (c2, lr)])
+    legs, towing = _bridle("rokkaku", top, foot, p.bridle, p.tow, p.tow_height)
+    return KiteGeometry(v, t, on_segments(v, spars), spars, p.rods.radius, p.rods.density,
+                        [(legs, towing)], foot.copy())
 
 
 def stunt(p: StuntParams, n: int = 8) -> KiteGeometry:
