@@ -79,7 +79,7 @@ def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
         ball = scene.add(Sphere(f"ball{k}", SphereParams(radius=r, mass=mass, shell=False,
                                                          dt=b.dt),
                                 position=(b.x[k], b.y[k], level + b.height[k] + r)))
-        standin = ViscousDragField(field, r, 4.0 / 3.0 * math.pi * r ** 3)
+        standin = ViscousDragField(field)
         scene.connect(BodyInWater(f"ball{k}-water", ball, water, params.buoyancy,
                                   mode=coupling, standin=standin))
         scene.connect(SpherePlaneContact(f"ball{k}-bed", ball, floor, params.bed))
