@@ -293,7 +293,7 @@ def emit_spray(grid, state, settings, H, count, dt):
             if n >= cap:
                 return n
             k = int(fraction * area * (r - threshold) * dt / vp + np.random.random())
-            k = min(k, int(V[i, j] / vp), cap - n)
+            k = min(k, int(V[i, j] * _KEEP / vp), cap - n)  # never below empty
             track[EMITTED] += k
             for _ in range(k):
                 x = x0 + (i + np.random.random() - 0.5) * l
