@@ -237,7 +237,7 @@ SPEC = SceneSpec(
     "diver", "a diver enters a pool from a 10 m platform; a drag field stands in for the "
     "water, then his motion drives the splash (hybrid)", build, DiverParams,
     couplings=("hybrid", "two-way", "one-way"), duration=5.5, fps=60.0,
-    camera=Camera(eye=(4.0, -24.0, 6.0), target=(3.0, 0.0, 4.5), fov_deg=38.0),
+    camera=Camera(eye=(7.0, -15.0, 5.5), target=(1.5, 0.0, 5.0), fov_deg=45.0),
     figures=dive_figures)
 
 
