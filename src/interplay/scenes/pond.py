@@ -90,7 +90,7 @@ def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
                                                          dt=b.dt),
                                 position=(b.x[k], b.y[k], level + b.height[k] + r)))
         ball.color = BALL_COLORS[k % len(BALL_COLORS)]
-        standin = ViscousDragField(field, r, 4.0 / 3.0 * math.pi * r ** 3)
+        standin = ViscousDragField(field)
         scene.connect(BodyInWater(f"ball{k}-water", ball, water, params.buoyancy,
                                   mode=coupling, standin=standin))
         scene.connect(SpherePlaneContact(f"ball{k}-bed", ball, floor, params.bed))

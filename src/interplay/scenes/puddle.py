@@ -114,9 +114,7 @@ def build(coupling: str = "one-way", duration: float = 1.5, fps: float = 60.0,
     # wet, dark pavement)
     water.bed_color, water.bank_color = (0.10, 0.10, 0.10), PAVEMENT
     scene.add(set_pieces([banks(geo, "pavement", 12.0, PAVEMENT)])[0])
-    a = params.foot.semi_axes
-    field = ViscousDragField(replace(params.field, surface=params.basin.depth),
-                             a[2], 4.0 / 3.0 * 3.141592653589793 * a[0] * a[1] * a[2])
+    field = ViscousDragField(replace(params.field, surface=params.basin.depth))
     scene.connect(BodyInWater("foot-water", foot, water, params.buoyancy, mode=coupling,
                               standin=field))
     scene.primary = foot
