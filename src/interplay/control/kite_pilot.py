@@ -44,7 +44,9 @@ class StuntPilotParams:
     largest heading used to hold; turn_gain (1/rad): steering per heading error; turn_damping
     (s/rad): steering against the heading's rate of turn, so the nose settles; throw (m):
     handle travel at full steering; brace (m): both handles drawn back during a manoeuvre (a
-    flyer leans back in a turn, keeping both lines taut); rate (Hz): how often the pilot looks
+    flyer leans back in a turn, keeping both lines taut); lead (s): a turn is let go this
+    long before the nose completes its circle at the present rate of turn (the arms and the
+    kite lag the hands); rate (Hz): how often the pilot looks
     and acts."""
     manoeuvre: str = "loop"
     start: float = 8.0
@@ -55,8 +57,9 @@ class StuntPilotParams:
     hold_tilt: float = 30.0
     turn_gain: float = 0.8
     turn_damping: float = 0.3
-    throw: float = 0.2
+    throw: float = 0.25
     brace: float = 0.0
+    lead: float = 0.2
     rate: float = 20.0
 
 
@@ -145,13 +148,15 @@ class StuntPilot:
             self.side, self.phase, self.turned = -self.side, TURN, 0.0
         if self.phase == TURN:
             self.u = float(self.side)
-            if self.side * self.turned >= 2.0 * math.pi:
+            ahead = max(0.0, self.side * rate) * p.lead
+            if self.side * self.turned + ahead >= 2.0 * math.pi:
                 eight = p.manoeuvre == "figure8" and self.side == self.log[-1][1]
                 self.phase = RECOVER if eight else HOLD
-                if not eight:
-                    self.log[-1][3] = t
             if self.phase == TURN:
                 return
+        if (self.phase == HOLD and self.log and self.log[-1][3] is None
+                and self.side * self.turned >= 2.0 * math.pi):
+            self.log[-1][3] = t  # the nose has come round a full circle: the loop is done
         tilt = math.radians(p.hold_tilt)
         self._steer(float(np.clip(-p.gain * (phi - math.radians(p.target)), -tilt, tilt)),
                     chi, rate)

@@ -80,6 +80,7 @@ class SegmentAttachment(Interaction):
         self._djac = np.broadcast_to(-self.c * np.eye(3), (n, 3, 3)).copy()
         self._f = np.zeros((n, 3))
         self._held = np.zeros((n, 3))  # the tie forces held on the network over the step
+        self._last = np.full(3, np.nan)  # m/s: the carrying part's velocity a step ago
         self._p = np.zeros((n, 3))
         self._v = np.zeros((n, 3))
         self._h = 0.0
@@ -123,6 +124,12 @@ class SegmentAttachment(Interaction):
         self._f[:] = self.k * (net.x[i] - target) + self.c * (net.v[i] - self._v)
         return self._finish(to_primary)
 
+    def capture(self) -> dict:
+        return {"last": self._last.copy()}
+
+    def restore(self, snap: dict) -> None:
+        self._last[:] = snap["last"]
+
     def _finish(self, to_primary):
         """Each tied part gets the sum of its ties' forces at its centre of mass and the sum
         of their moments about it (the same wrench as each force at its own point)."""
@@ -141,13 +148,22 @@ class SegmentAttachment(Interaction):
         """Give the part the network to carry: its mass, its inertia about the part's centre
         of mass and every force on its points at the step's end but the ties' (the sum of
         each point's mass times its acceleration, less the ties' held forces), with their
-        moment about the part's centre at the points' own positions."""
+        moment about the part's centre at the points' own positions. The part's centre is
+        not the composite's: its turning also answers the network's mass moment S = sum m r
+        dragged at the part's acceleration a (I alpha = tau - S x a; without it a sail's
+        weight would turn a falling frame), taken over the last step (explicit: S is
+        centimetre-kilograms beside the inertia)."""
         net, part = self.net, int(self._uniq[0])
         load = net.accelerations() * net.masses[:, None]
         np.subtract.at(load, self.index, self._held)
         c = self.body.centres()[part]
         r = net.x - c
         force, moment = load.sum(axis=0), np.cross(r, load).sum(axis=0)
+        lin = self.body.velocities(self._uniq)[0][0]
+        if np.all(np.isfinite(self._last)) and self._h > 0.0:
+            a = (lin - self._last) / self._h
+            moment -= np.cross((net.masses[:, None] * r).sum(axis=0), a)
+        self._last[:] = lin
         if to_primary:
             m = net.masses
             inertia = (m * np.einsum("ki,ki->k", r, r)).sum() * np.eye(3) - np.einsum(

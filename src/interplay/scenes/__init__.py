@@ -6,7 +6,8 @@ import importlib
 from ..errors import SceneError
 
 #: the scene modules, loaded on demand (a scene's module imports its systems)
-MODULES = ("basketball", "bungee", "diver", "flags", "leaves", "pond", "puddle")
+MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "pond", "puddle",
+           "stunt_kite")
 
 
 def spec(name: str):

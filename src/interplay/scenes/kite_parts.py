@@ -39,6 +39,16 @@ from ..systems.springmass import SpringNetwork, Springs
 from ..systems.wind import FlowPrimitive, WindField
 
 FLY_ELEVATION = 40.0  # deg: the lowest line elevation at which a kite is said to fly
+LANDED = 0.3  # m: a kite whose frame comes this low after its launch has come down
+LAUNCH = 2.0  # s: the launch, when a kite may still be low
+
+
+def came_down(frames) -> float | None:
+    """When (s) a kite's frame, from its recorded frames (``t``, ``position``), first came
+    below LANDED m after the launch; None if it stayed up."""
+    t, z = np.asarray(frames["t"]), np.asarray(frames["position"])[:, 2]
+    low = np.flatnonzero((t > LAUNCH) & (z < LANDED))
+    return float(t[low[0]]) if len(low) else None
 
 
 @dataclass(frozen=True)
@@ -290,6 +300,7 @@ def build_kite(scene, name: str, g: KiteGeometry, p: KiteParams, wind, ground, p
     rotation = np.asarray(rotation, float)
     position = np.asarray(position, float)
     world = lambda pts: position + np.asarray(pts, float) @ rotation.T  # noqa: E731
+    _check_line(name, g, p.line.length, p.tail.length, hands, ground.contact_view().height)
     frame = scene.add(frame_body(f"{name}-frame", g, position, rotation, p.sail.dt))
     fi = frame.inertia
     sail = scene.add(sail_network(f"{name}-sail", g, p.sail, position, rotation, color))
@@ -331,6 +342,23 @@ def build_kite(scene, name: str, g: KiteGeometry, p: KiteParams, wind, ground, p
         scene.connect(it)
     return Kite(name, frame, sail, lines, tail, [kn for _, kn, _ in index],
                 [end for _, _, end in index], bows, g, its)
+
+
+def _check_line(name, g: KiteGeometry, line: float, tail: float, hands, ground: float):
+    """Refuse a line too short to fly on: flown at FLY_ELEVATION, the towing point must be
+    high enough for the sail and the tail hanging below it to clear the ground by LANDED m
+    (else the tail drags and the kite is down before it flies). The message names the
+    shortest line that would do."""
+    reach = max(float(np.linalg.norm(g.sail - g.bridles[0][1], axis=1).max()), 0.0) + tail
+    hand = min(float(np.asarray(h, float)[2]) for h in hands) - ground
+    rise = math.sin(math.radians(FLY_ELEVATION))
+    if hand + line * rise >= reach + LANDED:
+        return
+    raise ParameterError(
+        f"kite {name}: a {line} m line holds it at most {hand + line * rise:.1f} m up at "
+        f"{FLY_ELEVATION:.0f} deg, less than the {reach:.1f} m of sail and tail below its "
+        f"towing point: the tail would drag on the ground; use a line of at least "
+        f"{(reach + LANDED - hand) / rise:.1f} m")
 
 
 def launch_pose(hand, length: float, elevation_deg: float, tow_kite, pitch_deg: float = 0.0,

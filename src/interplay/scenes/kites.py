@@ -31,7 +31,6 @@ DESIGNS = {"diamond": diamond, "eddy": diamond, "rokkaku": rokkaku}
 COLORS = {"diamond": ((0.80, 0.08, 0.06), (0.95, 0.80, 0.10)),
           "eddy": ((0.08, 0.25, 0.75), (0.95, 0.45, 0.05)),
           "rokkaku": ((0.92, 0.90, 0.85), (0.75, 0.06, 0.10))}
-LANDED = 0.3  # m: a kite whose frame comes this low after launch has come down
 SETTLE = 10.0  # s: the launch; flight statistics are over the time after it
 
 
@@ -95,17 +94,17 @@ def build(coupling: str = "two-way", duration: float = 30.0, fps: float = 30.0,
 
 def flight(result, name: str) -> dict:
     """One kite's flight from a run: flew_s (s aloft from the start until its frame first
-    came below LANDED m after the launch, or the whole run), and over the time after the
-    launch (SETTLE s) while it flew: the line elevation (deg: the kite seen from the hand,
-    mean, its standard deviation, min, max), the azimuth's rms (deg) and the yaw wander (deg,
-    the rms of its nose's heading in the wind window, 0 being straight up)."""
+    came below ``kite_parts.LANDED`` after the launch, or the whole run), and over the time
+    after the launch (SETTLE s) while it flew: the line elevation (deg: the kite seen from
+    the hand, mean, its standard deviation, min, max), the azimuth's rms (deg) and the yaw
+    wander (deg, the rms of its nose's heading in the wind window, 0 being straight up)."""
     fr = result.frames[f"{name}-frame"]
     t, pos, q = np.asarray(fr["t"]), np.asarray(fr["position"]), np.asarray(fr["orientation"])
     hand = result.meta["hands"][name]
-    low = np.flatnonzero((t > 2.0) & (pos[:, 2] < LANDED))
-    flew = float(t[low[0]]) if len(low) else float(t[-1])
+    down = KP.came_down(fr)
+    flew = float(t[-1]) if down is None else down
     keep = (t >= SETTLE) & (t <= flew)
-    out = {"flew_s": round(flew, 2), "crashed": bool(len(low))}
+    out = {"flew_s": round(flew, 2), "crashed": down is not None}
     if not keep.any():
         return out
     from ..kernels.rigid import quat_to_matrix

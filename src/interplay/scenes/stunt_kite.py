@@ -80,8 +80,9 @@ TAUT = 5.0  # a line pulls its handle with more than this many times its own wei
 
 def figures(result) -> dict:
     """The flight as numbers: each manoeuvre's duration (s, a loop's full turn of the nose;
-    an 8's two loops), whether each line was taut (pulling more than TAUT times its weight)
-    over the run after launch, and the kite's elevation (deg) range."""
+    an 8's two loops), the share of the time after the launch that each line was taut
+    (pulling more than TAUT times its weight), when the kite came down (s, None: it did not)
+    and its elevation (deg) range."""
     out = {}
     for k, (kind, sign, t0, t1) in enumerate(result.meta.get("manoeuvres", [])):
         side = "left" if sign > 0 else "right"
@@ -90,11 +91,12 @@ def figures(result) -> dict:
     for part in ("l_handle", "r_handle"):
         log = result.logs.get(f"stunt-{part}")
         if log is not None and len(log.t):
-            after = log.t >= 2.0
+            after = log.t >= KP.LAUNCH
             f = np.linalg.norm(log.force[after], axis=1)
             out[f"{part} taut share"] = round(float(np.mean(f > TAUT * weight)), 4)
     fr = result.frames.get("stunt-frame")
     if fr is not None and len(fr["t"]):
+        out["came down at s"] = KP.came_down(fr)
         c = result.meta["hands"]
         el = [math.degrees(window_coordinates(p, c)[1]) for p in fr["position"]]
         out["elevation min deg"] = round(min(el), 1)

@@ -4,7 +4,7 @@ A ``Renderer`` is made for one run and one image size; ``render(run, t)`` return
 uint8 image (h, w, 3) of every system at time t (s): rigid bodies, figures and static set
 pieces with smooth normals; deforming surfaces with per-frame normals (water translucent over
 its bed, only where the columns hold water); cord networks as instanced tubes at their real
-radius with a sphere at each knot (welded joints); spray as bright droplets at their radius;
+radius (at least a pixel wide) with a sphere at each knot (welded joints); spray as bright droplets at their radius;
 anchors as small dark hooks; a sun with soft shadows; 4x MSAA. Only what a scene has is drawn:
 a floor where it has one, at its height, ending softly into the sky; otherwise a backdrop.
 """
@@ -426,6 +426,7 @@ class Renderer:
                     vao.render(vertices=3 * ob["count"])
             elif ob["count"]:
                 _set(prog, "u_radius", ob["radius"])
+                _set(prog, "u_hair", 0.0 if depth_pass else 0.5 / self.px_per_m)
                 vao.render(instances=ob["count"])
 
     def render(self, run, t: float) -> np.ndarray:

@@ -73,6 +73,7 @@ in vec3 in_normal;
 in vec3 in_a;        // per instance: the cord's two end points (m)
 in vec3 in_b;
 uniform float u_radius;
+uniform float u_hair;  // m of radius per m of depth: half a pixel, the thinnest drawn
 uniform vec3 u_color;
 uniform mat4 u_vp;
 out vec3 v_pos;
@@ -80,12 +81,15 @@ out vec3 v_normal;
 out vec4 v_color;
 void main() {
     vec3 d = in_b - in_a;
+    // a cord thinner than a pixel at its distance (a kite line 30 m off) is drawn a pixel
+    // wide, as a photograph shows a line it cannot resolve
+    float r = max(u_radius, u_hair * (u_vp * vec4(in_a, 1.0)).w);
     float len = length(d);
     vec3 w = len > 1e-9 ? d / len : vec3(0.0, 0.0, 1.0);
     vec3 t = abs(w.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
     vec3 u = normalize(cross(w, t));
     vec3 v = cross(w, u);
-    vec3 p = in_a + (u * in_pos.x + v * in_pos.y) * u_radius + d * in_pos.z;
+    vec3 p = in_a + (u * in_pos.x + v * in_pos.y) * r + d * in_pos.z;
     v_pos = p;
     v_normal = u * in_normal.x + v * in_normal.y;
     v_color = vec4(u_color, 1.0);

@@ -1,0 +1,54 @@
+"""The kites' flights measured (issue 18): each single-line kite over a long flight (time
+aloft, line elevation, azimuth and yaw wander), the diamond flown without its tail, and the
+stunt kite's loops and figure-8s over several gust seeds (each manoeuvre's time, whether the
+kite came down, each line's taut share). Writes DIR/kite_flights.json; nothing passes or
+fails here (the tests assert the physics; this records what the scenes do).
+
+    .venv/bin/python benchmarks/kite_flights.py --out out/bench [--seeds 10] [--quick]
+"""
+from __future__ import annotations
+
+from common import machine, parse_args, write_json  # noqa: I001 (pins threads first)
+
+import time  # noqa: E402
+from dataclasses import replace  # noqa: E402
+
+from interplay.params import apply  # noqa: E402
+from interplay.scenes import kites, stunt_kite  # noqa: E402
+
+
+def single(duration, overrides=None):
+    """Every kite of the kites scene over ``duration`` s: its flight (``kites.flight``)."""
+    p = apply(kites.KitesParams(), overrides or {})
+    t0 = time.perf_counter()
+    res = kites.build(duration=duration, fps=10.0, params=p).simulate()
+    wall = time.perf_counter() - t0
+    return {"overrides": overrides or {}, "duration_s": duration, "wall_s": wall,
+            "kites": {name: kites.flight(res, name) for name in kites.KITES}}
+
+
+def stunt(manoeuvre, seed, duration):
+    """One stunt flight in the gusts of ``seed``: the scene's figures."""
+    p = stunt_kite.StuntKiteParams()
+    p = replace(p, control=replace(p.control, manoeuvre=manoeuvre),
+                wind=replace(p.wind, seed=seed))
+    t0 = time.perf_counter()
+    res = stunt_kite.build(duration=duration, fps=10.0, params=p).simulate()
+    return {"seed": seed, "wall_s": time.perf_counter() - t0,
+            "figures": stunt_kite.figures(res)}
+
+
+def main():
+    a, _ = parse_args(__doc__, lambda ap: ap.add_argument("--seeds", type=int, default=10))
+    long = 30.0 if a.quick else 130.0
+    seeds = range(2 if a.quick else a.seeds)
+    out = {"machine": machine(),
+           "single": single(long),
+           "diamond_without_tail": single(60.0 if not a.quick else 30.0,
+                                          {"diamond_parts.tail.length": "0"}),
+           "stunt": {m: [stunt(m, s, 36.0) for s in seeds] for m in ("loop", "figure8")}}
+    print(write_json(a.out, "kite_flights.json", out))
+
+
+if __name__ == "__main__":
+    main()
