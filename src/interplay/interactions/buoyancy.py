@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, SceneError, require_nonnegative
+from ..params import param
 from .base import Interaction
 
 #: fewer columns than this across a body and the grid cannot resolve it
@@ -44,9 +45,9 @@ class ResolutionWarning(UserWarning):
 @dataclass(frozen=True)
 class BuoyancyParams:
     """drag: C_d (-); rotational_drag: C_r (-); added_mass: C_a (-, 0.5 for a sphere, 0 off)."""
-    drag: float = 0.47
-    rotational_drag: float = 0.5
-    added_mass: float = 0.0
+    drag: float = param(0.47, "-", ge=0.0, le=100.0, doc="drag coefficient C_d")
+    rotational_drag: float = param(0.5, "-", ge=0.0, le=100.0, doc="C_r")
+    added_mass: float = param(0.0, "-", ge=0.0, le=10.0, doc="C_a (0.5 for a sphere)")
 
     def validated(self, owner):
         require_nonnegative(owner, "drag coefficient", self.drag)

@@ -25,6 +25,7 @@ from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
 from .contract import SceneSpec
+from ..params import param
 
 BRIDGE = 40.0  # m, the platform's top
 EDGE = 0.0  # m, x of the platform's front edge (the jumper faces +x)
@@ -47,14 +48,15 @@ class CordParams:
     frequency, where an elastic pendulum pumps its bounce into a growing swing; 250 N/m keeps
     the 64 kg jumper well clear of it (k L0 / m g = 5.9). Damping 0.05 s gives the bounce a
     damping ratio of about 0.05 (k beta / 2 sqrt(k m)), a rubber cord's hysteresis."""
-    enabled: bool = True
-    length: float = 15.0  # m
-    stiffness: float = 250.0  # N/m, whole cord: its n-1 springs in series
-    mass: float = 1.0  # kg
-    points: int = 21
-    damping: float = 0.05  # s
-    dt: float = 1e-3  # s
-    reach: float = 1.8  # m
+    enabled: bool = param(True, doc="false: the jumper alone (leap tuning)")
+    length: float = param(15.0, "m", gt=0.0, le=1000.0, doc="rest length")
+    # whole cord: its n-1 springs in series
+    stiffness: float = param(250.0, "N/m", gt=0.0, le=1e7, doc="the whole cord's")
+    mass: float = param(1.0, "kg", gt=0.0, le=1000.0)
+    points: int = param(21, "points", ge=3, le=10_000, cost="points")
+    damping: float = param(0.05, "s", ge=0.0, le=10.0, doc="stiffness-proportional")
+    dt: float = param(1e-3, "s", gt=0.0, le=0.1)
+    reach: float = param(1.8, "m", ge=0.0, le=100.0, doc="anchor past the deck's edge")
 
 
 @dataclass(frozen=True)
@@ -66,18 +68,18 @@ class JumperParams:
     hip (rad of hip flexion it extends to: a forward dive), power (-, scales the extension's
     velocity targets), arm_swing (rad of shoulder flexion the arms swing to); tuck (s) the knees
     are pulled up after takeoff so the feet clear the edge, before the layout."""
-    mass: float = 64.38  # kg
-    height: float = 1.70  # m
-    stand: float = 0.3  # s
-    crouch: float = 0.7  # s
-    depth: float = 0.65
-    lean: float = 0.36  # rad
-    lead: float = 0.16  # m
-    tip_ankle: float = 0.52  # rad
-    hip: float = 0.67  # rad
-    power: float = 1.24
-    arm_swing: float = 1.00  # rad
-    tuck: float = 0.75  # s
+    mass: float = param(64.38, "kg", ge=10.0, le=500.0)
+    height: float = param(1.70, "m", ge=0.5, le=3.0)
+    stand: float = param(0.3, "s", ge=0.0, le=100.0)
+    crouch: float = param(0.7, "s", ge=0.0, le=100.0)
+    depth: float = param(0.65, "-", ge=0.0, le=2.0, doc="crouch depth, 1 = deep")
+    lean: float = param(0.36, "rad", ge=-1.6, le=1.6, doc="trunk lean in the crouch")
+    lead: float = param(0.16, "m", ge=-1.0, le=1.0, doc="centre of mass ahead of the feet")
+    tip_ankle: float = param(0.52, "rad", ge=-1.6, le=1.6, doc="ankle dorsiflexion to tip")
+    hip: float = param(0.67, "rad", ge=-1.6, le=2.6, doc="hip flexion of the push")
+    power: float = param(1.24, "-", ge=0.0, le=5.0, doc="scales the extension's velocities")
+    arm_swing: float = param(1.00, "rad", ge=-3.2, le=3.2, doc="shoulder flexion of the swing")
+    tuck: float = param(0.75, "s", ge=0.0, le=100.0, doc="knees pulled up after takeoff")
 
 
 @dataclass(frozen=True)
@@ -86,8 +88,8 @@ class BungeeParams:
     jumper: JumperParams = JumperParams()
     cord: CordParams = CordParams()
     tie: AttachmentParams = AttachmentParams()
-    coupling_dt: float = 1e-3  # s
-    air_density: float = 1.2  # kg/m^3
+    coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.1)
+    air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0, doc="0: no drag")
 
 
 def controller(p: JumperParams) -> Controller:
