@@ -344,6 +344,9 @@ def finite_outputs(out: Path) -> str:
                     rows = np.isfinite(a).all(-1) | np.isnan(a).all(-1)
                     if not rows.all():
                         return f"{key}: a partly non-finite particle"
+                elif key.endswith("/particle_radius"):  # NaN past the particle count
+                    if np.isinf(a).any():
+                        return f"{key}: inf"
                 elif not np.isfinite(a).all():
                     return f"{key}: non-finite"
     return ""

@@ -37,9 +37,9 @@ def test_keys_lists_every_leaf():
     ("inner.x", "1", "unknown parameter; valid keys: inner.k"),
     ("inner", "1", "is a group"),
     ("n.m", "1", "unknown parameter"),
-    ("n", "1.5", "expected a int value"),
-    ("inner.on", "maybe", "expected a bool value"),
-    ("dt", "soon", "expected a float value"),
+    ("n", "1.5", "not a whole number; n must be a whole number"),
+    ("inner.on", "maybe", "inner.on=maybe: not true or false"),
+    ("dt", "soon", "dt=soon: .soon. is not a number; dt must be a finite number"),
 ])
 def test_bad_overrides_say_what_is_wrong(key, value, message):
     with pytest.raises(ParameterError, match=message):

@@ -100,7 +100,7 @@ class Domain:
         else:
             what = "a whole number" if self.kind == "int" else "a finite number"
             text = f"{what} {b}{unit}" if b else f"{what}{unit}"
-        return text + (" (or none)" if self.optional else "")
+        return text + (" (or none)" if self.optional and self.default is not None else "")
 
     def _fail(self, shown, why: str = ""):
         raise ParameterError(f"{self.key}={shown}: {why or 'out of range'}; {self.key} must "
@@ -122,7 +122,7 @@ class Domain:
                 return False
             self._fail(text, "not true or false")
         if self.kind == "str":
-            return self.validate(text)
+            return self.validate(text, text)
         if self.kind == "vector":
             items = text.replace("(", "").replace(")", "").split(",")
             items = [] if items == [""] else items
@@ -322,8 +322,9 @@ def keys(params) -> list[str]:
     return [d.key for d in domains(params)]
 
 
-def _unknown(key, params):
-    return ParameterError(f"{key}: unknown parameter; valid keys: {', '.join(keys(params))}")
+def _unknown(key, params, prefix=""):
+    return ParameterError(f"{key}: unknown parameter; valid keys: "
+                          f"{', '.join(prefix + k for k in keys(params))}")
 
 
 def override(params, key: str, value, prefix: str = ""):
@@ -333,7 +334,7 @@ def override(params, key: str, value, prefix: str = ""):
     head, _, rest = key.partition(".")
     fields = {f.name: f for f in dataclasses.fields(params)}
     if head not in fields:
-        raise _unknown(prefix + key, params)
+        raise _unknown(prefix + key, params, prefix)
     current = getattr(params, head)
     if dataclasses.is_dataclass(current):
         if not rest:
@@ -342,7 +343,7 @@ def override(params, key: str, value, prefix: str = ""):
         new = override(current, rest, value, f"{prefix}{head}.")
     else:
         if rest:
-            raise _unknown(prefix + key, params)
+            raise _unknown(prefix + key, params, prefix)
         d = domain_of(type(params), fields[head], current, prefix + key)
         try:
             new = d.parse(value) if isinstance(value, str) else d.validate(value)

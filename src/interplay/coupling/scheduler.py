@@ -52,6 +52,7 @@ class Pass:
     record: list = field(default_factory=list)   # live systems whose full-rate track is kept
     wall_s: float = 0.0
     steps: int = 0
+    work: float = 0.0  # state values advanced: substeps x values, summed over live systems
     h: float = 0.0
     dts: dict = field(default_factory=dict)      # system name -> largest substep (s)
 
@@ -62,7 +63,8 @@ class Pass:
     def describe(self) -> dict:
         """The pass as data (summary.json's timings)."""
         return {"systems": [s.name for s in self.live], "played": [s.name for s in self.played],
-                "wall_s": self.wall_s, "steps": self.steps, "coupling_dt_s": self.h,
+                "wall_s": self.wall_s, "steps": self.steps, "work": self.work,
+                "coupling_dt_s": self.h,
                 "substep_s": dict(self.dts)}
 
 
@@ -306,6 +308,8 @@ class Runner:
                                  f"coupling steps of {h:g} s: pass {p.label} runs {n} steps, "
                                  f"{n * h:.9g} s")
         p.h, p.steps, p.wall_s = h, n, 0.0
+        p.work = float(n * sum(substeps(h, p.dts[s.name]) * s.generalized_state()[0].size
+                               for s in p.live))
         self.monitor = Monitor(p.live)
         self.state = _PassState(recs=[TrackRecorder(s.name, n + 1,
                                                     s.generalized_state()[0].size)
@@ -458,7 +462,8 @@ class Runner:
                   "attempt": self.attempt, "failed_at": self.failed_at,
                   "warnings": self.warnings, "extra": self.extra,
                   "passes": [{"label": q.label, "dts": q.dts, "wall_s": q.wall_s,
-                              "steps": q.steps, "h": q.h} for q in self.passes],
+                              "steps": q.steps, "h": q.h, "work": q.work}
+                             for q in self.passes],
                   "systems": [s.name for s in self.systems]}
         self.ckpt.save(header, a, self.state.k * p.h)
 
@@ -473,6 +478,7 @@ class Runner:
         for q, saved in zip(self.passes, header["passes"]):
             q.dts.update(saved["dts"])
             q.wall_s, q.steps, q.h = saved["wall_s"], saved["steps"], saved["h"]
+            q.work = saved["work"]
         for s in self.systems:
             s.restore(C.take(a, f"sys/{s.name}"))
         now = {it.name: C.take(a, f"int/{it.name}") for it in self.interactions}

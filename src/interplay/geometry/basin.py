@@ -22,9 +22,9 @@ class BasinParams:
     size_y: float = param(2.0, "m", ge=0.01, le=1000.0, doc="grid extent along y")
     # columns along x; along y in proportion: cells^2 size_y / size_x columns in all
     cells: int = param(128, "columns", ge=4, le=4096, cost=("columns", 2))
-    depth: float = param(0.3, "m", gt=0.0, le=100.0, doc="still water over the flat bed")
+    depth: float = param(0.3, "m", ge=1e-3, le=100.0, doc="still water over the flat bed")
     shore: float = param(0.3, "m", ge=0.0, le=1000.0, doc="width of the sloping shore")
-    rim: float = param(1.3, "x depth", ge=0.0, le=100.0, doc="bed height at the rim")
+    rim: float = param(1.3, "x depth", ge=1.0, le=100.0, doc="bed height at the rim")
     shape: str = param("ellipse", choices=SHAPES)
 
     def __post_init__(self):

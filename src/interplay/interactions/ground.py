@@ -25,10 +25,10 @@ class GroundParams:
     per kg, 1/s): 300 is about half critical at that stiffness; friction: mu; eps (m/s):
     sliding speed below which friction is viscous; thickness (m): contact offset above the
     plane (half a leaf's thickness, so it does not look sunk)."""
-    stiffness: float = param(1.0e5, "1/s^2", gt=0.0, le=1e10, doc="per kg of point mass")
+    stiffness: float = param(1.0e5, "1/s^2", ge=1e-6, le=1e10, doc="per kg of point mass")
     damping: float = param(300.0, "1/s", ge=0.0, le=1e7, doc="per kg of point mass")
     friction: float = param(0.6, "-", ge=0.0, le=10.0)
-    eps: float = param(0.01, "m/s", gt=0.0, le=100.0)
+    eps: float = param(0.01, "m/s", ge=1e-6, le=100.0)
     thickness: float = param(0.001, "m", ge=0.0, le=1.0)
 
 

@@ -76,9 +76,9 @@ def listing(root: Path) -> dict:
     """{relative path: {"bytes", "sha256"}} of every file under root (folders walked)."""
     out = {}
     for p in sorted(root.rglob("*")):
-        if p.is_file() and not p.name.startswith("."):
-            rel = p.relative_to(root).as_posix()
-            out[rel] = {"bytes": p.stat().st_size, "sha256": sha256(p)}
+        rel = p.relative_to(root)
+        if p.is_file() and not any(part.startswith(".") for part in rel.parts):
+            out[rel.as_posix()] = {"bytes": p.stat().st_size, "sha256": sha256(p)}
     return out
 
 

@@ -43,7 +43,7 @@ class BasketballParams:
     settle: bool = param(True, doc="let the net sag to rest under gravity before t = 0")
     # s: forces are exchanged every coupling_dt; the net sub-cycles the ball contact inside it.
     # Set it to the net's dt for strict lock step (the reference).
-    coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.1, doc="force exchange step")
+    coupling_dt: float = param(1e-3, "s", ge=1e-7, le=0.1, doc="force exchange step")
     # "cords": the specialised sphere-cord contact (sub-cycled in the net's kernel); "mesh":
     # the general MeshContact between the ball's icosphere (mesh_subdivisions) and the cords as
     # segments, exchanged every net step (lock step: it is not sub-cycled), docs/collision.md

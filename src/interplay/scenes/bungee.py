@@ -49,13 +49,13 @@ class CordParams:
     the 64 kg jumper well clear of it (k L0 / m g = 5.9). Damping 0.05 s gives the bounce a
     damping ratio of about 0.05 (k beta / 2 sqrt(k m)), a rubber cord's hysteresis."""
     enabled: bool = param(True, doc="false: the jumper alone (leap tuning)")
-    length: float = param(15.0, "m", gt=0.0, le=1000.0, doc="rest length")
+    length: float = param(15.0, "m", ge=0.1, le=1000.0, doc="rest length")
     # whole cord: its n-1 springs in series
-    stiffness: float = param(250.0, "N/m", gt=0.0, le=1e7, doc="the whole cord's")
-    mass: float = param(1.0, "kg", gt=0.0, le=1000.0)
+    stiffness: float = param(250.0, "N/m", ge=1e-3, le=1e7, doc="the whole cord's")
+    mass: float = param(1.0, "kg", ge=1e-3, le=1000.0)
     points: int = param(21, "points", ge=3, le=10_000, cost="points")
     damping: float = param(0.05, "s", ge=0.0, le=10.0, doc="stiffness-proportional")
-    dt: float = param(1e-3, "s", gt=0.0, le=0.1)
+    dt: float = param(1e-3, "s", ge=1e-9, le=0.1)
     reach: float = param(1.8, "m", ge=0.0, le=100.0, doc="anchor past the deck's edge")
 
 
@@ -88,7 +88,7 @@ class BungeeParams:
     jumper: JumperParams = JumperParams()
     cord: CordParams = CordParams()
     tie: AttachmentParams = AttachmentParams()
-    coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.1)
+    coupling_dt: float = param(1e-3, "s", ge=1e-7, le=0.1)
     air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0, doc="0: no drag")
 
 

@@ -27,19 +27,19 @@ class FlagParams:
     the implicit solve's relative residual (1e-5 moves a point ~1e-5 of its step's change:
     invisible, and it halves the CG iterations of 1e-8)."""
     pole: tuple = param((0.0, 0.0, 0.0), "m", ge=-100.0, le=100.0, doc="foot of the pole")
-    pole_height: float = param(3.0, "m", gt=0.0, le=100.0, doc="the flag's top edge")
-    width: float = param(1.5, "m", gt=0.0, le=50.0)
-    height: float = param(1.0, "m", gt=0.0, le=50.0)
+    pole_height: float = param(3.0, "m", ge=0.01, le=100.0, doc="the flag's top edge")
+    width: float = param(1.5, "m", ge=0.01, le=50.0)
+    height: float = param(1.0, "m", ge=0.01, le=50.0)
     nu: int = param(30, "vertices", ge=2, le=2000, cost="points", doc="along the flag")
     nv: int = param(20, "vertices", ge=2, le=2000, cost="points", doc="down the flag")
-    density: float = param(0.15, "kg/m^2", gt=0.0, le=100.0)  # cotton bunting
+    density: float = param(0.15, "kg/m^2", ge=1e-4, le=100.0)  # cotton bunting
     # ~3000 N/m membrane stiffness at this spacing, cotton-like
-    stretch: float = param(150.0, "N", gt=0.0, le=1e9, doc="stress/strain ratio")
-    shear: float = param(50.0, "N", gt=0.0, le=1e9)
-    bend: float = param(0.5, "N", gt=0.0, le=1e9)
+    stretch: float = param(150.0, "N", ge=1e-6, le=1e9, doc="stress/strain ratio")
+    shear: float = param(50.0, "N", ge=1e-6, le=1e9)
+    bend: float = param(0.5, "N", ge=1e-6, le=1e9)
     mass_damping: float = param(0.05, "1/s", ge=0.0, le=1e4)
     stiffness_damping: float = param(2e-4, "s", ge=0.0, le=1.0)
-    dt: float = param(1.0 / 240.0, "s", gt=0.0, le=0.1)
+    dt: float = param(1.0 / 240.0, "s", ge=1e-9, le=0.1)
     integrator: str = param("implicit", choices=("explicit", "implicit", "localglobal"))
     cg_tolerance: float = param(1e-5, "-", ge=1e-14, le=0.1, doc="implicit solve's residual")
 
@@ -52,7 +52,7 @@ class GustyWind:
     speed: float = param(6.0, "m/s", ge=0.0, le=100.0)
     heading: float = param(0.0, "deg", ge=-360.0, le=360.0)
     gust: float = param(0.4, "-", ge=0.0, le=1.0, doc="share of the speed")
-    gust_period: float = param(2.5, "s", gt=0.0, le=1000.0)
+    gust_period: float = param(2.5, "s", ge=0.01, le=1000.0)
     cross: float = param(1.0, "m/s", ge=-100.0, le=100.0)
 
 

@@ -27,14 +27,14 @@ class BallsParams:
     x and y of the drop (m), drop height of the ball's bottom above the still surface (m).
     dt: the balls' step (s)."""
     count: int = param(5, "balls", ge=1, le=100)
-    radius: tuple = param((0.07, 0.06, 0.05, 0.065, 0.055), "m", gt=0.0, le=1.0, length=None)
-    density: tuple = param((500.0, 300.0, 700.0, 850.0, 2500.0), "kg/m^3", gt=0.0, le=1e5,
+    radius: tuple = param((0.07, 0.06, 0.05, 0.065, 0.055), "m", ge=1e-3, le=1.0, length=None)
+    density: tuple = param((500.0, 300.0, 700.0, 850.0, 2500.0), "kg/m^3", ge=1.0, le=1e5,
                            length=None)
     x: tuple = param((-0.35, 0.3, -0.2, 0.35, 0.0), "m", ge=-1e3, le=1e3, length=None)
     y: tuple = param((0.25, 0.3, -0.35, -0.2, 0.0), "m", ge=-1e3, le=1e3, length=None)
     height: tuple = param((0.25, 0.4, 0.15, 0.3, 0.5), "m", ge=-100.0, le=1e3, length=None,
                           doc="drop height of each ball's bottom above the still surface")
-    dt: float = param(1e-3, "s", gt=0.0, le=0.1)
+    dt: float = param(1e-3, "s", ge=1e-9, le=0.1)
 
     def __post_init__(self):
         for key in ("radius", "density", "x", "y", "height"):
@@ -56,7 +56,7 @@ class PondParams:
     # hybrid: still water at the basin's depth, damping fitted by eye to the two-way bobbing
     field: ViscousDragFieldParams = ViscousDragFieldParams(linear=2.0, quadratic=20.0,
                                                            density=1000.0)
-    coupling_dt: float = param(2e-3, "s", gt=0.0, le=0.1)
+    coupling_dt: float = param(2e-3, "s", ge=1e-7, le=0.1)
 
 
 def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,

@@ -40,9 +40,9 @@ class FootParams(KeyframedBodyParams):
                               0.55, 0.0, 0.3), "m", ge=-1e4, le=1e4, length=None,
                              doc="x, y, z of each key")
     # a shoe 26 cm long, 10 cm wide
-    semi_axes: tuple = param((0.13, 0.05, 0.045), "m", gt=0.0, le=10.0)
-    mass: float = param(1.2, "kg", gt=0.0, le=1e4, doc="foot and shank")
-    dt: float = param(0.002, "s", gt=0.0, le=1.0)
+    semi_axes: tuple = param((0.13, 0.05, 0.045), "m", ge=1e-3, le=10.0)
+    mass: float = param(1.2, "kg", ge=1e-3, le=1e4, doc="foot and shank")
+    dt: float = param(0.002, "s", ge=1e-9, le=1.0)
 
 
 @dataclass(frozen=True)
@@ -56,7 +56,7 @@ class PuddleParams:
     foot: FootParams = FootParams()
     buoyancy: BuoyancyParams = BuoyancyParams()
     field: ViscousDragFieldParams = ViscousDragFieldParams(linear=2.0, quadratic=20.0)
-    coupling_dt: float = param(2e-3, "s", gt=0.0, le=0.1)
+    coupling_dt: float = param(2e-3, "s", ge=1e-7, le=0.1)
     # the runner; "": the keyframed foot
     clip: str = param("cmu_02_03_run.bvh", check=check_clip,
                       doc="a BVH clip in the mocap folder or a path; empty: keyframes")

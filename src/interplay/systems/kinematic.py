@@ -26,18 +26,18 @@ class KeyframedBodyParams:
                          doc="key times, increasing")
     positions: tuple = param((0.0, 0.0, 0.0, 1.0, 0.0, 0.0), "m", ge=-1e4, le=1e4, length=None,
                              doc="x, y, z of each key")
-    semi_axes: tuple = param((0.13, 0.05, 0.045), "m", gt=0.0, le=10.0)
+    semi_axes: tuple = param((0.13, 0.05, 0.045), "m", ge=1e-3, le=10.0)
     yaw: float = param(0.0, "rad", ge=-100.0, le=100.0)
-    mass: float = param(1.1, "kg", gt=0.0, le=1e4)
-    dt: float = param(0.01, "s", gt=0.0, le=1.0)
+    mass: float = param(1.1, "kg", ge=1e-3, le=1e4)
+    dt: float = param(0.01, "s", ge=1e-9, le=1.0)
 
     def __post_init__(self):
         t = self.times
         if len(t) < 2 or any(b <= a for a, b in zip(t, t[1:])):
-            raise ParameterError(f"times {t} must be at least 2 strictly increasing keys")
+            raise ParameterError(f"key times must increase strictly (at least 2 keys), got {t}")
         if len(self.positions) != 3 * len(t):
-            raise ParameterError(f"positions holds {len(self.positions)} numbers but the "
-                                 f"{len(t)} keys need x, y, z each ({3 * len(t)})")
+            raise ParameterError(f"positions must hold x, y, z for each of the {len(t)} keys "
+                                 f"({3 * len(t)} numbers), got {len(self.positions)}")
 
 
 class KeyframedBody(System, RigidParts):

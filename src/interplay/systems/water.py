@@ -35,7 +35,7 @@ class SprayParams:
     enabled: bool = True
     threshold: float = param(0.6, "m/s", ge=0.0, le=100.0)
     fraction: float = param(0.3, "-", ge=0.0, le=1.0)
-    radius: float = param(0.004, "m", gt=0.0, le=0.1)
+    radius: float = param(0.004, "m", ge=1e-5, le=0.1)
     capacity: int = param(4096, "particles", ge=0, le=10_000_000, cost="particles")
     drag: float = param(0.47, "-", ge=0.0, le=10.0)
     air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
@@ -51,10 +51,10 @@ class WaterParams:
     body touches the water the substeps shrink by sqrt(1 + kappa). body_samples: sample points
     per column side where a body cuts the columns. body_damping (1/s): extra pipe friction
     under a body (its wetted surface), which damps waves trapped under it."""
-    density: float = param(1000.0, "kg/m^3", gt=0.0, le=1e5)
-    gravity: float = param(9.81, "m/s^2", gt=0.0, le=100.0)
+    density: float = param(1000.0, "kg/m^3", ge=1.0, le=1e5)
+    gravity: float = param(9.81, "m/s^2", ge=0.01, le=100.0)
     damping: float = param(0.5, "1/s", ge=0.0, le=1e4)
-    cfl: float = param(0.5, "-", gt=0.0, le=0.7)
+    cfl: float = param(0.5, "-", ge=0.01, le=0.7)
     dt: float = param(0.0, "s", ge=0.0, le=0.1, doc="0: automatic")
     # the substeps shrink by sqrt(1 + kappa) under a body: 1e4 is 100x the steps
     body_stiffness: float = param(30.0, "-", ge=0.0, le=1e4)
