@@ -50,15 +50,15 @@ BAD = [
     (["run", "nowhere"], "unknown scene 'nowhere'"),
     (["run", "basketball", "--coupling", "sideways"], "unknown coupling"),
     (["run", "basketball", "--set", "ball.mass=-1"], "ball.mass=-1: out of range; ball.mass "
-     "must be a finite number > 0 and <= 1e+06 kg"),
-    (["run", "basketball", "--set", "ball.mass=0"], "ball.mass must be a finite number > 0"),
-    (["run", "basketball", "--set", "ball.radius=0"], "ball.radius must be a finite number > 0"),
-    (["run", "basketball", "--set", "net.cord_ea=-5"], "net.cord_ea must be a finite number > 0"),
+     "must be a finite number >= 0.0001 and <= 1e+06 kg"),
+    (["run", "basketball", "--set", "ball.mass=0"], "ball.mass must be a finite number >= 0.0001"),
+    (["run", "basketball", "--set", "ball.radius=0"], "ball.radius must be a finite number >= 0.001"),
+    (["run", "basketball", "--set", "net.cord_ea=-5"], "net.cord_ea must be a finite number >= 0.001"),
     (["run", "basketball", "--set", "contact.stiffness=0"], "contact.stiffness must be"),
     (["run", "basketball", "--dt", "0"], "--dt 0: out of range; --dt must be a finite number "
-     "> 0 and <= 1 s"),
-    (["run", "basketball", "--duration", "-1"], "--duration must be a finite number > 0"),
-    (["run", "basketball", "--duration", "0"], "--duration must be a finite number > 0"),
+     ">= 1e-12 and <= 1 s"),
+    (["run", "basketball", "--duration", "-1"], "--duration must be a finite number >= 1e-06"),
+    (["run", "basketball", "--duration", "0"], "--duration must be a finite number >= 1e-06"),
     (["run", "basketball", "--set", "net.colour=red"], "unknown parameter; valid keys"),
     (["run", "basketball", "--set", "ball.mass=heavy"], "'heavy' is not a number"),
     (["run", "basketball", "--set", "nomass"], "expected KEY=VALUE"),
@@ -72,7 +72,7 @@ BAD = [
     (["run", "bungee", "--set", "jumper.mass=1e-308"], "jumper.mass must be a finite number >= "
      "10 and <= 500 kg"),
     (["run", "pond", "--set", "basin.size_x=1e-308"], "basin.size_x must be"),
-    (["run", "basketball", "--fps", "1e308"], "--fps must be a finite number > 0 and <= 10000"),
+    (["run", "basketball", "--fps", "1e308"], "--fps must be a finite number >= 0.01 and <= 10000"),
 ]
 
 

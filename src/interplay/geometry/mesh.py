@@ -98,21 +98,16 @@ def load(path, name: str | None = None) -> tuple[np.ndarray, np.ndarray]:
 
     Vertices are kept exactly as in the file (trimesh's merging is off). Quads and polygons are
     triangulated by trimesh. A scene with several objects is concatenated."""
-    import stat
     from pathlib import Path
 
     import trimesh
+
+    from ..io.inputs import regular_file
     p = Path(path)
     name = name or p.name
-    try:
-        st = p.stat()
-    except OSError:
-        raise ParameterError(f"{name}: mesh file {p} does not exist") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise ParameterError(f"{name}: {p} is not a regular file; a mesh must be a file")
-    if st.st_size > MAX_FILE_BYTES:
-        raise ParameterError(f"{name}: {p} is {st.st_size / 2 ** 20:.0f} MiB, over the "
-                             f"{MAX_FILE_BYTES // 2 ** 20} MiB a mesh file may have")
+    if not p.exists():
+        raise ParameterError(f"{name}: mesh file {p} does not exist")
+    regular_file(p, MAX_FILE_BYTES, "mesh file", ParameterError)
     try:
         mesh = trimesh.load(p, force="mesh", process=False)
     except Exception as e:  # trimesh raises many kinds for unreadable files

@@ -95,18 +95,8 @@ MAX_JOINTS = 512
 def check_file(path) -> Path:
     """``path`` if it is a regular file no larger than MAX_BYTES; BVHError otherwise (a FIFO,
     a device such as /dev/zero, a folder or a missing file is refused before it is opened)."""
-    import stat
-    path = Path(path)
-    try:
-        st = path.stat()
-    except OSError as e:
-        raise BVHError(f"{path}: cannot read BVH file ({e.strerror or e})") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise BVHError(f"{path}: not a regular file; a BVH clip must be a file")
-    if st.st_size > MAX_BYTES:
-        raise BVHError(f"{path}: {st.st_size / 2 ** 20:.0f} MiB is larger than the "
-                       f"{MAX_BYTES // 2 ** 20} MiB a BVH clip may have; trim the clip")
-    return path
+    from .inputs import regular_file
+    return regular_file(path, MAX_BYTES, "BVH clip", BVHError)
 
 
 def read_bvh(path) -> Motion:
