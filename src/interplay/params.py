@@ -377,6 +377,14 @@ def validate(params, prefix: str = ""):
     return params
 
 
+def zero_or_at_least(lo: float):
+    """A check: 0 (meaning automatic) or at least ``lo``."""
+    def check(v):
+        if v != 0 and v < lo:
+            raise ParameterError(f"0 (automatic) or at least {lo:g}")
+    return check
+
+
 def intervals(v):
     """A check: a vector of (lo, hi) pairs, each with lo < hi (an area x0, x1, y0, y1)."""
     if len(v) % 2 or any(a >= b for a, b in zip(v[::2], v[1::2])):

@@ -12,8 +12,12 @@ from pathlib import Path
 from dataclasses import dataclass
 
 from .. import params as P
-from ..errors import CostError, InterplayError, ParameterError
+from ..errors import CostError, InterplayError, ParameterError, StabilityError
 from ..params import param
+
+
+#: the smallest preview the captions fit in (the overlay's text is ~130 px wide, 34 px high)
+MIN_SIZE = (160, 90)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -102,6 +106,10 @@ def _outputs(args, spec=None):
     from ..outputs.render.video import check_size
     if len(w) > 6 or len(h) > 6:
         raise ParameterError(f"--size {args.size}: at most 999999 pixels a side")
+    if (not args.no_video or not args.no_report) and (int(w) < MIN_SIZE[0]
+                                                      or int(h) < MIN_SIZE[1]):
+        raise ParameterError(f"--size {args.size}: the preview and its captions need at least "
+                             f"{MIN_SIZE[0]}x{MIN_SIZE[1]} pixels")
     size = check_size((int(w), int(h)))
     return OutputOptions(usd=not args.no_usd, usd_format="usda" if args.usda else "usdc",
                          obj=not args.no_obj, video=not args.no_video, report=not args.no_report,
@@ -172,16 +180,31 @@ def build_scene(spec, mode, kw):
                         "column)") from None
 
 
-def run_scene(spec, mode, kw, quiet=True, force=False, checkpointer=None, resume=None):
-    """Build and simulate one scene in one coupling mode (checked against its spec)."""
+def run_scene(spec, mode, kw, quiet=True, force=False, checkpointer=None, resume=None,
+              given: str = ""):
+    """Build and simulate one scene in one coupling mode (checked against its spec).
+    given: what the command line set ("--dt 1e-9, --set net.loops=40"), named in front of
+    an error the build or the run raises (a stability bound, a cost), since it is the cause."""
     from .progress import PassProgress
-    scene = build_scene(spec, mode, kw)
     try:
-        return scene.simulate(progress=PassProgress(scene.duration, quiet), force=force,
-                              checkpointer=checkpointer, resume=resume)
-    except MemoryError:
-        raise CostError(f"{spec.name}: out of memory while simulating; shorten --duration, "
-                        "lower --fps, or lower the element counts") from None
+        scene = build_scene(spec, mode, kw)
+        try:
+            return scene.simulate(progress=PassProgress(scene.duration, quiet), force=force,
+                                  checkpointer=checkpointer, resume=resume)
+        except MemoryError:
+            raise CostError(f"{spec.name}: out of memory while simulating; shorten "
+                            "--duration, lower --fps, or lower the element counts") from None
+    except InterplayError as e:
+        if given:
+            raise type(e)(f"with {given}: {e}") from None
+        raise
+
+
+def _given(args) -> str:
+    """The options and --set assignments the command line gave, as typed."""
+    out = [f"--{k} {getattr(args, k)}" for k in ("duration", "fps", "dt", "integrator")
+           if getattr(args, k, None) is not None]
+    return ", ".join(out + [f"--set {s}" for s in args.sets])
 
 
 def scene_summary(spec, result, **advice_kw) -> dict:
@@ -251,7 +274,12 @@ def cmd_run(args, console):
                           opts.checkpoint_every, 60.0 * opts.checkpoint_minutes or None)
     with Lock(out):
         claim(out)
-        result = run_scene(spec, mode, kw, args.quiet, args.force, ckpt, resume)
+        try:
+            result = run_scene(spec, mode, kw, args.quiet, args.force, ckpt, resume,
+                               _given(args))
+        except StabilityError:  # resuming would only repeat it
+            (out / C.FILE).unlink(missing_ok=True)
+            raise
         paths = write_outputs(result, out, options, scene_summary(spec, result), run_id,
                               _request(args), locked=True)
         (out / C.FILE).unlink(missing_ok=True)

@@ -137,10 +137,11 @@ def plan(systems, interactions) -> list[Pass]:
 
 
 
-#: the most a run may cost without --force: state values advanced (substeps x values) and the
-#: memory kept for tracks and frames. The default scenes need 1e7 to 2e8 values advanced and
-#: tens of MB; 1e11 is a few hours on this machine's core (docs/robustness.md)
-BUDGET = {"work": 1e11, "bytes": 4 * 2 ** 30}
+#: the most a run may cost without --force: state values advanced (substeps x values), substeps
+#: (each has a fixed cost: an implicit solve, a MuJoCo step, ~10-20 us) and the memory kept
+#: for tracks and frames. The default scenes advance 8e5 to 7e7 values in 1.2e3 to 1.5e5
+#: substeps and keep 1 to 100 MB (docs/robustness.md); the budget is ~100x that
+BUDGET = {"work": 1e10, "substeps": 2e7, "bytes": 4 * 2 ** 30}
 
 
 def estimate(passes, duration, fps, coupling_dt) -> dict:
@@ -152,7 +153,8 @@ def estimate(passes, duration, fps, coupling_dt) -> dict:
     for p in passes:
         h = coupling_dt or min(p.dts.values())
         n = duration / h
-        row = {"systems": p.label, "h": h, "steps": n, "substeps": {}, "work": 0.0}
+        row = {"systems": p.label, "h": h, "steps": n, "substeps": {}, "work": 0.0,
+               "dts": dict(p.dts)}
         for s in p.live:
             dof = s.generalized_state()[0].size
             sub = n * max(1.0, math.ceil(h / p.dts[s.name] - 1e-9))
@@ -178,9 +180,18 @@ def check_budget(est: dict, scene: str, force: bool = False):
         sub = max(worst["substeps"].items(), key=lambda kv: kv[1])
         raise CostError(f"{scene}: the run would advance {est['work']:.3g} state values "
                         f"(budget {BUDGET['work']:.0e}): {sub[0]} takes {sub[1]:.3g} substeps "
-                        f"({worst['steps']:.3g} coupling steps of {worst['h']:.3g} s); "
+                        f"of {worst['dts'][sub[0]]:.3g} s ({worst['steps']:.3g} coupling "
+                        f"steps of {worst['h']:.3g} s); "
                         "shorten --duration, raise --dt or the step in --set, or pass --force "
                         "to go on anyway")
+    subs = sum(sum(r["substeps"].values()) for r in est["passes"])
+    if subs > BUDGET["substeps"]:
+        worst = max(((name, n, r) for r in est["passes"] for name, n in r["substeps"].items()),
+                    key=lambda x: x[1])
+        raise CostError(f"{scene}: the run would take {subs:.3g} substeps (budget "
+                        f"{BUDGET['substeps']:.0e}): {worst[0]} takes {worst[1]:.3g} substeps "
+                        f"of {worst[2]['dts'][worst[0]]:.3g} s; shorten --duration, raise "
+                        "--dt or the step in --set, or pass --force to go on anyway")
     if est["bytes"] > BUDGET["bytes"]:
         raise CostError(f"{scene}: the run would keep about {est['bytes'] / 2 ** 30:.3g} GiB of "
                         f"tracks and frames (budget {BUDGET['bytes'] / 2 ** 30:.0f} GiB); lower "
@@ -191,6 +202,27 @@ class _Unstable(Exception):
     def __init__(self, system, warnings, t):
         super().__init__("; ".join(warnings))
         self.system, self.warnings, self.t = system, warnings, t
+
+
+#: what a step raises when its state or forces went non-finite (NumPy and Numba's linear
+#: algebra refuse NaN, an overflow in a conversion): treated as the pass being unstable
+NUMERIC = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
+
+
+def _blame(p, err) -> _Unstable:
+    """The likely cause among the pass's unhealthy systems: the one with the smallest step
+    (the stiffest: non-finite forces spread from it to the others within the coupling step),
+    else the error itself."""
+    bad = [(p.dts[s.name], i, s, s.health()) for i, s in enumerate(p.live)]
+    bad = [b for b in bad if b[3]]
+    if bad:
+        _, _, s, w = min(bad, key=lambda b: b[:2])
+        others = [b[2].name for b in bad if b[2] is not s]
+        also = f" (and so {', '.join(others)})" if others else ""
+        return _Unstable(s, [w[0] + also], s.time)
+    s = p.live[0]
+    return _Unstable(s, [f"{s.name}: a step failed at t={s.time:.4f} s "
+                         f"({type(err).__name__}: {err})"], s.time)
 
 
 class Monitor:
@@ -286,6 +318,8 @@ class Runner:
                     break
                 except _Unstable as e:
                     self._rerun_or_raise(p, e)
+                except NUMERIC as e:  # a step fed non-finite forces or a singular matrix
+                    self._rerun_or_raise(p, _blame(p, e))
             for s in p.live:
                 self.monitors[s.name] = self.monitor
             self.index += 1
@@ -293,6 +327,12 @@ class Runner:
         return self.tracks, self.frames, self.warnings, self.monitors
 
     def _start(self, p):
+        for s in p.live:  # bad from the start (a network that could not settle): no rerun
+            w = s.health()
+            if w:
+                raise StabilityError(f"{w[0]}, before the first step: the scene was built in a "
+                                     "state it cannot run from; nothing was written as a "
+                                     f"result; {_fix(s)}")
         self.snaps = {"sys": {s.name: s.capture() for s in p.live},
                       "int": {it.name: it.capture() for it, _ in p.actions}}
         self._fresh(p)
@@ -335,8 +375,10 @@ class Runner:
             it.restore(self.snaps["int"][it.name])
         self.failed_at.append(e.t)
         where = f"{e}; {e.system.name} failed at t={e.t:.4g} s"
-        # a smaller step that fails no later than the larger one did is not the cure
-        helpless = len(self.failed_at) > 1 and self.failed_at[-1] <= 1.05 * self.failed_at[-2]
+        # a smaller step that fails no later than the larger one did is not the cure (failures
+        # are seen every ~1 ms, so two within the first few checks tell nothing apart)
+        helpless = (len(self.failed_at) > 1 and self.failed_at[-2] > 10 * max(p.h, 1e-3)
+                    and self.failed_at[-1] <= 1.05 * self.failed_at[-2])
         if not self.refine or self.attempt >= self.max_refinements or helpless:
             tried = (f" (and again at t={self.failed_at[-1]:.4g} s with dt="
                      f"{p.dts[e.system.name]:.3g} s: smaller steps did not help, so the cause "

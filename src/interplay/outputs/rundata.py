@@ -25,6 +25,7 @@ QUATERNION_KEYS = ("orientation", "segment_orientations")  # (w, x, y, z), last 
 FRAME_KEYS = ("t", "points", "position", "orientation", "segment_positions",
               "segment_orientations", "heights", "particles")
 FORMAT_VERSION = 1
+FORMS = ("body", "parts", "surface", "cords", "particles", "static")
 
 # linear RGB in 0..1, per palette family (systems/shape.py)
 _PALETTE = {"rigid": [(0.85, 0.38, 0.10), (0.20, 0.45, 0.80), (0.30, 0.65, 0.30)],
@@ -201,10 +202,17 @@ def load_run(run_dir) -> RunData:
     shapes = []
     for i, sd in enumerate(doc["shapes"]):
         try:
-            shapes.append(Shape.from_json(sd))
+            sh = Shape.from_json(sd)
+            if not (isinstance(sh.name, str) and sh.form in FORMS and isinstance(sh.palette, str)
+                    and len(sh.color) == 3 and np.isfinite(np.asarray(sh.color, float)).all()
+                    and np.isfinite(sh.width)):
+                raise ValueError("name, form, palette, color or width")
+            shapes.append(sh)
         except Exception as e:  # noqa: BLE001 - any malformed entry is the same answer
             raise InterplayError(f"{scene_path}: shape {i} is malformed ({type(e).__name__}: "
                                  f"{e}); run the scene again") from None
+    if len({sh.name for sh in shapes}) != len(shapes):
+        raise InterplayError(f"{scene_path}: two shapes share a name; run the scene again")
     frames: dict = {}
     try:
         with np.load(tracks_path, allow_pickle=False) as npz:

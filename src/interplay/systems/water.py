@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
-from ..params import param
+from ..params import param, zero_or_at_least
 from ..kernels import water as K
 from .base import System
 from .shape import Shape
@@ -33,10 +33,10 @@ class SprayParams:
     capacity: most particles airborne at once (output frames are padded to it); drag: drag
     coefficient (-) of a droplet in air of density air_density (kg/m^3)."""
     enabled: bool = True
-    threshold: float = param(0.6, "m/s", ge=0.0, le=100.0)
+    threshold: float = param(0.6, "m/s", ge=1e-6, le=100.0)
     fraction: float = param(0.3, "-", ge=0.0, le=1.0)
     radius: float = param(0.004, "m", ge=1e-5, le=0.1)
-    capacity: int = param(4096, "particles", ge=0, le=10_000_000, cost="particles")
+    capacity: int = param(4096, "particles", ge=1, le=10_000_000, cost="particles")
     drag: float = param(0.47, "-", ge=0.0, le=10.0)
     air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
 
@@ -55,9 +55,10 @@ class WaterParams:
     gravity: float = param(9.81, "m/s^2", ge=0.01, le=100.0)
     damping: float = param(0.5, "1/s", ge=0.0, le=1e4)
     cfl: float = param(0.5, "-", ge=0.01, le=0.7)
-    dt: float = param(0.0, "s", ge=0.0, le=0.1, doc="0: automatic")
+    dt: float = param(0.0, "s", ge=0.0, le=0.1, check=zero_or_at_least(1e-9),
+                      doc="0: automatic")
     # the substeps shrink by sqrt(1 + kappa) under a body: 1e4 is 100x the steps
-    body_stiffness: float = param(30.0, "-", ge=0.0, le=1e4)
+    body_stiffness: float = param(30.0, "-", ge=1e-6, le=1e4)
     body_samples: int = param(4, "-", ge=1, le=16)
     body_damping: float = param(200.0, "1/s", ge=0.0, le=1e5)
     spray: SprayParams = SprayParams()
