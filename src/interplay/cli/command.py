@@ -356,7 +356,7 @@ def _on_sigterm(signum, frame):
     raise Terminated()
 
 
-def _quiet_mujoco():
+def quiet_mujoco():
     """MuJoCo writes MUJOCO_LOG.TXT into the working directory on a warning; nothing is
     written outside --out, so its warnings are collected (and shown as one line) instead."""
     try:
@@ -378,7 +378,7 @@ def main(argv=None) -> int:
         signal.signal(signal.SIGTERM, _on_sigterm)
     except ValueError:  # not the main thread
         previous = None
-    _quiet_mujoco()
+    quiet_mujoco()
     try:
         COMMANDS[args.command](args, console)
     except InterplayError as e:
