@@ -299,6 +299,10 @@ def folder_cases(rng, good: Path, folder: Path, n: int):
             with open(p, "wb") as fh:
                 np.savez(fh, **arrays, allow_pickle=True) if kind == "npz-pickle" else \
                     np.savez(fh, **arrays)
+        if rng.random() < 0.5 and (d / "manifest.json").exists():
+            # without the manifest (an older folder, or a deleted one) the contents are checked
+            (d / "manifest.json").unlink()
+            kind += "-no-manifest"
         cases.append(("folder", {"dir": str(d)}, {"key": "dir", "value": str(d), "file": kind}))
     return cases
 
@@ -447,6 +451,7 @@ def main():
     from interplay.scenes import all_specs
     from interplay.systems.mocap import clip_path
     rng = random.Random(args.seed)
+    machine = common.machine()
     work = Path(tempfile.mkdtemp(prefix="interplay-fuzz-"))
     specs = all_specs()
     surfaces = args.surfaces.split(",")
@@ -484,7 +489,7 @@ def main():
             total[kind] = total.get(kind, 0) + n
     result = {"label": args.label, "seed": args.seed, "cases": len(cases), "counts": counts,
               "total": total, "wall_s": time.monotonic() - t0, "not_clean": bad,
-              "machine": common.machine()}
+              "machine": machine}
     name = f"fuzz{'-' + args.label if args.label else ''}.json"
     print(json.dumps(total))
     print("wrote", common.write_json(args.out, name, result))

@@ -223,12 +223,17 @@ def _damage(d, kind):
             np.savez(fh, **arrays)
 
 
+@pytest.mark.parametrize("manifest", [True, False], ids=["manifest", "no-manifest"])
 @pytest.mark.parametrize("kind", ["summary-truncated", "scene-without-fps", "tracks-truncated",
                                   "points-mismatch", "pickled", "nan", "other-run"])
-def test_damaged_saved_runs_are_one_line(saved_run, tmp_path, kind):
+def test_damaged_saved_runs_are_one_line(saved_run, tmp_path, kind, manifest):
+    """With its manifest, any edit of a listed file is refused by size; without one (a folder
+    of an older version, or a deleted manifest) the contents themselves are checked."""
     from interplay.outputs.rundata import load_run
     d = tmp_path / "run"
     shutil.copytree(saved_run, d)
+    if not manifest:
+        (d / "manifest.json").unlink()
     _damage(d, kind)
     with pytest.raises(InterplayError) as e:
         load_run(d)

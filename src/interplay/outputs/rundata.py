@@ -224,16 +224,18 @@ def load_run(run_dir) -> RunData:
     except Exception as e:  # noqa: BLE001 - zip, zlib, format and pickle refusals alike
         raise InterplayError(f"{tracks_path}: cannot read the saved run ({type(e).__name__}: "
                              f"{e}); run it again") from None
+    summary = _json_file(d / "summary.json") if (d / "summary.json").is_file() else None
+    # the manifest's id, else scene.json's: every file of the folder must carry it
+    run_id = run_id or doc.get("run_id")
     for what, rid in (("scene.json", doc.get("run_id")),
-                      ("tracks.npz", None if ids is None else str(ids))):
+                      ("tracks.npz", None if ids is None else str(ids)),
+                      ("summary.json", summary.get("run_id", run_id)
+                       if isinstance(summary, dict) else run_id)):
         if run_id is not None and rid != run_id:
-            raise InterplayError(f"{d}: {what} belongs to run {rid}, not to run {run_id} of "
-                                 "the manifest (a folder mixing two runs); run the scene again")
+            raise InterplayError(f"{d}: {what} belongs to run {rid}, not to run {run_id} (a "
+                                 "folder mixing two runs); run the scene again")
     _check(frames, shapes, tracks_path)
     frames = _derive(frames, shapes)
-    summary = None
-    if (d / "summary.json").is_file():
-        summary = _json_file(d / "summary.json")
     return RunData(doc["scene"], doc["coupling"], float(doc["fps"]), float(doc["duration_s"]),
                    shapes, frames, doc.get("primary"), summary)
 
@@ -263,8 +265,15 @@ def _check(frames: dict, shapes, path):
     particles are whole NaN rows)."""
     by_name = {sh.name: sh for sh in shapes}
     for sh in shapes:
-        if sh.animated and sh.source is None and sh.name not in frames:
-            raise InterplayError(f"{path}: no frames for {sh.name}; run the scene again")
+        if sh.animated and sh.source is None:
+            need = {"body": ("position", "orientation"),
+                    "parts": ("segment_positions", "segment_orientations"),
+                    "surface": ("heights",) if sh.grid_xy is not None else ("points",),
+                    "cords": ("points",)}.get(sh.form, ())
+            missing = [k for k in ("t", *need) if k not in frames.get(sh.name, {})]
+            if missing:
+                raise InterplayError(f"{path}: no {', '.join(missing)} frames for {sh.name}; "
+                                     "run the scene again")
     for name, fr in frames.items():
         t = fr.get("t")
         if t is None or t.ndim != 1 or len(t) == 0:
@@ -277,6 +286,12 @@ def _check(frames: dict, shapes, path):
                                      f"{a.dtype}; expected ({len(t)}, "
                                      f"{', '.join('n' if w is None else str(w) for w in want)})"
                                      " floats; run the scene again")
+            sh = by_name.get(name)
+            idx = None if sh is None else (sh.triangles if sh.triangles is not None
+                                           else sh.segments)
+            if key == "points" and idx is not None and len(idx) and a.shape[1] <= idx.max():
+                raise InterplayError(f"{path}: {name}/points has {a.shape[1]} points but its "
+                                     f"shape uses point {int(idx.max())}; run the scene again")
             ok = np.isfinite(a)
             if key == "particles":
                 ok = ok.all(-1) | np.isnan(a).all(-1)
