@@ -201,7 +201,7 @@ def mesh_cases(rng, folder: Path, n: int):
         elif kind == "scale":
             s = rng.choice([1e-300, 1e300, 1e-12])
             verts = [(x * s, y * s, z * s) for x, y, z in verts]
-        lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in verts] + \
+        lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in verts] + \
                 [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in tris]
         text = "\n".join(lines) + "\n"
         if kind == "truncated":

@@ -294,3 +294,15 @@ def test_help_params_lists_every_key(capsys):
     assert main(["run", "basketball", "--help-params", "json"]) == 0
     schema = json.loads(capsys.readouterr().out)
     assert schema["properties"]["ball"]["properties"]["radius"]["x-unit"] == "m"
+
+
+def test_a_missing_default_clip_warns_and_a_set_one_is_an_error(tmp_path, monkeypatch, capsys):
+    """With no mocap folder (a fresh install) the puddle runs its keyframed foot and says so in
+    its warnings; a clip the user names must exist."""
+    monkeypatch.setenv("INTERPLAY_MOCAP_DIR", str(tmp_path / "empty"))
+    out = tmp_path / "out"
+    assert main(["run", "puddle", *SHORT, "--out", str(out)]) == 0
+    warnings = json.loads((out / "summary.json").read_text())["warnings"]
+    assert any("clip='cmu_02_03_run.bvh' (the default): no clip" in w for w in warnings)
+    code = main(["run", "puddle", "--set", "clip=cmu_02_03_run.bvh", *SHORT, "--out", str(out)])
+    assert code == 2 and "no clip 'cmu_02_03_run.bvh'" in capsys.readouterr().err

@@ -364,17 +364,26 @@ def apply(params, assignments: dict):
     return params
 
 
-def validate(params, prefix: str = ""):
+def validate(params, prefix: str = "", trusted=()) -> list[str]:
     """Check every leaf of ``params`` against its domain (values given through the Python API
-    or as defaults); returns params. ParameterError on the first that is out of its domain."""
+    or as defaults): ParameterError on the first that is out of its domain. For the keys in
+    ``trusted`` (the defaults nobody set) a field's own ``check`` (a file that must exist) is
+    not an error: its message is returned, so the caller can report it as a warning."""
+    notes = []
     for d in domains(params, prefix):
         value = d.default
         try:
+            if d.key in trusted and d.check is not None:
+                try:
+                    d.check(value)
+                except ParameterError as e:
+                    notes.append(f"{d.key}={_show(value)} (the default): {e}")
+                d = dataclasses.replace(d, check=None)
             d.validate(value)
         except OverflowError:
             raise ParameterError(f"{d.key}={_show(value)}: too large; {d.key} must be "
                                  f"{d.range_text()}") from None
-    return params
+    return notes
 
 
 def zero_or_at_least(lo: float):

@@ -562,16 +562,6 @@ class Runner:
         self.resumed = True
 
 
-def run_passes(passes, duration, fps, coupling_dt, logs, progress=None, refine_unstable=True,
-               max_refinements=2):
-    """Run every pass in order (``Runner`` without checkpoints); returns (tracks, frames,
-    warnings, monitors)."""
-    systems = list(dict.fromkeys(s for p in passes for s in p.live + p.played))
-    interactions = list(dict.fromkeys(it for p in passes for it, _ in p.actions))
-    return Runner(systems, interactions, passes, duration, fps, coupling_dt, logs, progress,
-                  refine_unstable, max_refinements).run()
-
-
 def as_array_frames(frames: dict) -> dict:
     """Turn per-frame dicts into stacked arrays: {system: {"t": (f,), key: (f, ...)}}."""
     out = {}
