@@ -44,3 +44,12 @@ def test_keys_lists_every_leaf():
 def test_bad_overrides_say_what_is_wrong(key, value, message):
     with pytest.raises(ParameterError, match=message):
         P.apply(Outer(), {key: value})
+
+
+def test_a_field_of_another_type_is_kept_but_not_settable():
+    @dataclass(frozen=True)
+    class WithList:
+        names: list = field(default_factory=list)
+    assert P.table(WithList())[0][3] == "set in Python only"
+    with pytest.raises(ParameterError, match="cannot be set from the command line"):
+        P.apply(WithList(), {"names": "a,b"})

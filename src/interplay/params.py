@@ -59,7 +59,7 @@ def param(default, unit: str = "", *, gt=None, ge=None, lt=None, le=None, length
 class Domain:
     """The domain of one parameter (see the module docstring). key: its dotted name."""
     key: str
-    kind: str  # float | int | bool | str | vector
+    kind: str  # float | int | bool | str | vector | other (not settable from text)
     default: object
     unit: str = ""
     lo: float | None = None
@@ -92,6 +92,8 @@ class Domain:
         elif self.kind == "str":
             text = ("one of " + ", ".join(repr(c) for c in self.choices) if self.choices
                     else "a text")
+        elif self.kind == "other":
+            text = "set in Python only"
         elif self.kind == "vector":
             n = ("any number of" if self.length is None else
                  " or ".join(str(k) for k in self.length) if isinstance(self.length, tuple)
@@ -115,6 +117,8 @@ class Domain:
         low = text.strip().lower()
         if self.optional and low in ("none", "auto"):
             return None
+        if self.kind == "other":
+            self._fail(text[:40], "this parameter cannot be set from the command line")
         if self.kind == "bool":
             if low in ("1", "true", "yes", "on"):
                 return True
@@ -147,6 +151,8 @@ class Domain:
             if self.optional:
                 return None
             self._fail(shown, "a value is required")
+        if self.kind == "other":
+            return value
         if self.kind == "bool":
             if not isinstance(value, bool):
                 self._fail(shown, "not true or false")
@@ -225,6 +231,8 @@ class Domain:
             s = num
         elif self.kind == "bool":
             s = {"type": "boolean"}
+        elif self.kind == "other":
+            s = {}
         elif self.kind == "str":
             s = {"type": "string", "maxLength": MAX_STR}
             if self.choices:
@@ -237,7 +245,9 @@ class Domain:
                 s.update(minItems=min(self.length), maxItems=max(self.length))
         if self.optional:
             s = {"anyOf": [s, {"type": "null"}]}
-        s["default"] = list(self.default) if isinstance(self.default, tuple) else self.default
+        if self.kind != "other":
+            s["default"] = list(self.default) if isinstance(self.default, tuple) \
+                else self.default
         if self.unit:
             s["x-unit"] = self.unit
         if self.cost:
@@ -285,9 +295,8 @@ def domain_of(cls, f: dataclasses.Field, default, key: str) -> Domain:
         kind = "str"
     elif base is tuple:
         kind = "vector"
-    else:
-        raise TypeError(f"{cls.__name__}.{f.name}: parameters are bool, int, float, str, tuple "
-                        f"or a nested dataclass, not {typ}")
+    else:  # a list, a mapping, a callable: kept as given, not settable with --set
+        kind = "other"
     length = meta.get("length", len(default) if isinstance(default, tuple) else None)
     lo = hi = None
     lo_open = hi_open = False
