@@ -54,9 +54,9 @@ def keyframed():
 
 def rider():
     from interplay.scenes.leaves import RiderParams, rider_path
+    from interplay.geometry.bicycle import Bicyclist
     from interplay.systems.path import PathFollower
-    v, t = shapes.bicyclist()
-    return PathFollower("bicyclist", rider_path(RiderParams()), v, t)
+    return PathFollower("bicyclist", rider_path(RiderParams()), Bicyclist())
 
 
 def mocap():

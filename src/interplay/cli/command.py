@@ -33,7 +33,7 @@ class RunOptions:
     duration: float | None = param(None, "s", ge=1e-6, le=1e6, doc="simulated time")
     fps: float | None = param(None, "frames/s", ge=0.01, le=10_000.0)
     dt: float | None = param(None, "s", ge=1e-12, le=1.0, doc="spring-mass step")
-    video_fps: float = param(30.0, "frames/s", ge=1.0, le=240.0)
+    video_fps: float = param(24.0, "frames/s", ge=1.0, le=240.0)
     checkpoint_every: float | None = param(None, "s", gt=0.0, le=1e6,
                                            doc="simulated seconds between checkpoints")
     checkpoint_minutes: float = param(5.0, "min", ge=0.0, le=1e4,
@@ -88,9 +88,13 @@ def _output_options(p):
     g.add_argument("--camera", default=None, metavar="EYE:TARGET[:FOV]",
                    help='preview camera "eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]"'
                         " in m and degrees (default: frame every system)")
-    g.add_argument("--size", default="1280x720", metavar="WxH", help="video size in pixels")
-    g.add_argument("--video-fps", default=None, help="video frames per second (default 30)")
+    g.add_argument("--size", default="960x540", metavar="WxH",
+                   help="video size in pixels (default 960x540; 1280x720 costs twice as much)")
+    g.add_argument("--video-fps", default=None,
+                   help="video frames per second (default 24, animation's rate)")
     g.add_argument("--usda", action="store_true", help="write text .usda instead of .usdc")
+    g.add_argument("--obj", action="store_true",
+                   help="also write OBJ sequences (a file per frame per system; off by default)")
     for name in ("usd", "obj", "video", "report"):
         g.add_argument(f"--no-{name}", action="store_true", help=f"skip the {name} output")
 
@@ -112,7 +116,8 @@ def _outputs(args, spec=None):
                              f"{MIN_SIZE[0]}x{MIN_SIZE[1]} pixels")
     size = check_size((int(w), int(h)))
     return OutputOptions(usd=not args.no_usd, usd_format="usda" if args.usda else "usdc",
-                         obj=not args.no_obj, video=not args.no_video, report=not args.no_report,
+                         obj=args.obj and not args.no_obj, video=not args.no_video,
+                         report=not args.no_report,
                          size=size, video_fps=_options(args).video_fps,
                          camera=(parse_camera(args.camera) if args.camera
                                  else spec.camera if spec is not None else None),
@@ -361,15 +366,19 @@ def _on_sigterm(signum, frame):
     raise Terminated()
 
 
+#: MuJoCo's warnings of this process (quiet_mujoco), newest last
+MUJOCO_WARNINGS: list = []
+
+
 def quiet_mujoco():
     """MuJoCo writes MUJOCO_LOG.TXT into the working directory on a warning; nothing is
-    written outside --out, so its warnings are collected (and shown as one line) instead."""
+    written outside --out, so its warnings are kept in MUJOCO_WARNINGS instead (the one it
+    gives for an unstable figure, NaN in its state, is the figure's health() report too)."""
     try:
         import mujoco
     except ImportError:
         return
-    mujoco.set_mju_user_warning(lambda msg: print(f"interplay: mujoco: {msg.strip()}",
-                                                  file=sys.stderr))
+    mujoco.set_mju_user_warning(lambda msg: MUJOCO_WARNINGS.append(msg.strip()))
 
 
 def main(argv=None) -> int:

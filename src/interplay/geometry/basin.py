@@ -81,3 +81,25 @@ def basin(p: BasinParams) -> Basin:
     bed = np.where(fluid, bed, rim)
     d = np.where(fluid, np.maximum(depth - bed, 0.0), 0.0)
     return Basin(bed=bed, fluid=fluid, depth=d, spacing=l, origin=(float(x[0]), float(y[0])))
+
+
+def banks(b: Basin, name: str, size: float, color=(0.30, 0.42, 0.20)):
+    """The ground around a basin (a setpieces.Piece): flat at the height of its rim, out to
+    size (m) from the centre, with a hole where the basin's own bed (over its column centres)
+    is drawn."""
+    from .setpieces import ground_around
+    nx, ny = b.bed.shape
+    lo = np.asarray(b.origin, float)
+    hi = lo + b.spacing * np.array([nx - 1, ny - 1])
+    return ground_around(lo, hi, float(b.bed.max()), size, name, color)
+
+
+def terrain(b: Basin):
+    """height(x, y) -> z (m): the basin's bed (bilinear between column centres) inside its
+    grid, the rim's height (the ground around it) outside."""
+    from scipy.interpolate import RegularGridInterpolator
+    nx, ny = b.bed.shape
+    x = b.origin[0] + b.spacing * np.arange(nx)
+    y = b.origin[1] + b.spacing * np.arange(ny)
+    f = RegularGridInterpolator((x, y), b.bed, bounds_error=False, fill_value=float(b.bed.max()))
+    return lambda px, py: float(f([[px, py]])[0])

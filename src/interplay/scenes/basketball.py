@@ -6,12 +6,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..geometry.net import NetParams, basketball_net
+from ..geometry.setpieces import hoop
 from ..interactions.contact import ContactParams, SphereCordContact, SpherePlaneContact
 from ..interactions.standins import DampingField, DampingFieldParams
-from ..errors import ParameterError
+from ..outputs.render.camera import Camera
 from ..scene import Scene
 from ..systems.base import GRAVITY
+from ..systems.colliders import set_pieces
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
 from .contract import SceneSpec
@@ -56,6 +59,15 @@ FIT_TIME = 0.6  # s: the ball has left the net and not yet reached the floor
 CHECKPOINTS = [0.2, 0.3, 0.4, 0.5, 0.6]  # s, the ball's state is reported at these times
 
 
+def seams(verts) -> np.ndarray:
+    """(n,3) linear RGB per vertex of the ball: orange leather with a basketball's black seams
+    (two great circles and two rings), so its spin shows."""
+    n = verts / np.linalg.norm(verts, axis=1, keepdims=True)
+    seam = (np.abs(n[:, 0]) < 0.06) | (np.abs(n[:, 2]) < 0.06) | (np.abs(np.abs(n[:, 1]) - 0.72)
+                                                                  < 0.05)
+    return np.where(seam[:, None], (0.06, 0.04, 0.03), (0.80, 0.33, 0.08))
+
+
 def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
           integrator: str | None = None, dt: float | None = None,
           params: BasketballParams = BasketballParams()) -> Scene:
@@ -73,7 +85,14 @@ def build(coupling: str = "two-way", duration: float = 1.5, fps: float = 60.0,
     net = scene.add(basketball_net(net_p))
     if params.settle:
         net.settle()
-    floor = scene.add(StaticPlane("floor", height=0.0))
+    floor = scene.add(StaticPlane("floor", height=0.0, size=15.0, color=(0.62, 0.44, 0.26),
+                                  material="wood"))
+    # the hoop the net hangs from (Figure 2): rim, backboard and pole, drawn; the ball's
+    # default path stays inside the rim and clear of the board, so no contact joins them
+    for piece in set_pieces(hoop((0.0, 0.0, net_p.rim_height), net_p.rim_radius)):
+        scene.add(piece)
+    ball.color = seams(ball.surface[0])
+    net.color = (0.95, 0.95, 0.93)
     field_ = DampingField(net.x, net.segments(), params.field, thickness=net_p.cord_radius)
     contact = replace(params.contact, thickness=net_p.cord_radius)
     if params.contact_model == "mesh":
@@ -119,4 +138,6 @@ SPEC = SceneSpec(
     "basketball", "a basketball falls through a spring-mass net (two-way, one-way or hybrid)",
     build, BasketballParams, couplings=("two-way", "one-way", "hybrid"), duration=1.5, fps=60.0,
     integrators=("explicit", "implicit", "localglobal"), standin="field", fit_time=FIT_TIME,
+    # the net and the ball in it fill the frame (Figure 2), a little below the rim
+    camera=Camera((1.25, -2.55, 3.35), (0.0, 0.0, 3.05), 24.0), key_time=0.33,
     figures=exit_figures)

@@ -19,11 +19,15 @@ import numpy as np
 from ..control import behaviours as B
 from ..control.fsm import Controller, State, Transition
 from ..geometry.anthropometry import SEGMENTS, BodyParams
+from ..geometry.setpieces import bridge
 from ..interactions.attachment import AttachmentParams, SegmentAttachment
+from ..outputs.render.camera import TrackingCamera
 from ..scene import Scene
+from ..systems.colliders import set_pieces
 from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
+from ..systems.static import StaticPlane
 from .contract import SceneSpec
 from ..params import param
 
@@ -35,6 +39,8 @@ STRAP_STIFFNESS = 2.0e4  # N/m, each strap (webbing: stiff beside the cord)
 TIP_MAX = 1.5  # s: the leap starts by then even if the lean never gets far enough
 STRAIN_LIMIT = 3.0  # a bungee cord is made to stretch (15 m to ~26 m at the bottom here)
 ANCHOR_HEIGHT = 0.5  # m above the deck: the jump arm the cord hangs from
+PLATFORM = (-3.0, EDGE, -1.5, 1.5)  # m: x0, x1, y0, y1 of the jump platform's top
+CORD_RADIUS = 0.016  # m: a jumper's bungee, a bundle of latex strands ~3 cm across
 
 
 @dataclass(frozen=True)
@@ -108,7 +114,7 @@ def controller(p: JumperParams) -> Controller:
 
 def jumper(p: JumperParams, air_density: float = 1.2) -> Figure:
     """The jumper on the bridge platform, under his leap controller; air_density (kg/m^3)."""
-    env = EnvironmentParams(floor=None, platform=(-3.0, EDGE, -1.5, 1.5, BRIDGE),
+    env = EnvironmentParams(floor=None, platform=(*PLATFORM, BRIDGE),
                             air_density=air_density)
     return Figure("jumper", FigureParams(body=BodyParams(p.mass, p.height), environment=env,
                                          position=(STANCE_X, 0.0, BRIDGE)), controller(p))
@@ -134,7 +140,8 @@ def cord(c: CordParams, anchor, ankles, integrator="implicit", dt=None) -> Sprin
                       np.ones(n + 1, dtype=bool))
     net = SpringNetwork("cord", x, c.mass / (n + 2), springs, dt=dt or c.dt, integrator=integrator,
                         stiffness_damping=c.damping, fixed=[0, n, n + 1],
-                        strain_limit=STRAIN_LIMIT)
+                        strain_limit=STRAIN_LIMIT, cord_radius=CORD_RADIUS,
+                        color=(0.95, 0.75, 0.10))
     net.settle(1.0)
     net.fixed[[n, n + 1]] = False  # the straps move with the ankles from here on
     return net
@@ -147,11 +154,16 @@ def build(coupling: str = "two-way", duration: float = 8.0, fps: float = 30.0,
     scene = Scene("bungee", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
     fig = scene.add(jumper(params.jumper, params.air_density))
     scene.primary = fig
+    anchor = [EDGE + c.reach, 0.0, BRIDGE + ANCHOR_HEIGHT]
+    # the bridge he leaps from: its deck, the platform (the figure's own collision model
+    # holds it), the jump arm the cord hangs from, and the valley floor far below
+    for piece in set_pieces(bridge(BRIDGE, EDGE, PLATFORM, anchor)):
+        scene.add(piece)
+    scene.add(StaticPlane("valley", height=0.0, size=80.0, color=(0.28, 0.40, 0.20)))
     if c.enabled:
         feet = ("l_foot", "r_foot")
         ankles = fig.contact_view().poses()[0][[SEGMENTS.index(f) for f in feet]]
-        net = scene.add(cord(c, [EDGE + c.reach, 0.0, BRIDGE + ANCHOR_HEIGHT], ankles,
-                             integrator or "implicit", dt))
+        net = scene.add(cord(c, anchor, ankles, integrator or "implicit", dt))
         n = c.points
         scene.connect(SegmentAttachment("cord", fig, net, ((n, feet[0]), (n + 1, feet[1])),
                                         params=params.tie, mode=coupling))
@@ -216,7 +228,10 @@ def tune_leap(evaluations: int = 150, seed: int = 0, start: JumperParams = Jumpe
 SPEC = SceneSpec(
     "bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)", build,
     BungeeParams, couplings=("two-way", "one-way"), duration=8.0, fps=30.0,
-    integrators=("explicit", "implicit", "localglobal"))
+    integrators=("explicit", "implicit", "localglobal"),
+    # beside him and a little above, 6.7 m off: he stays a third of the frame tall all the way
+    camera=TrackingCamera("jumper", offset=(5.2, -4.0, 1.2), target_offset=(0.4, 0.0, -0.3),
+                          fov_deg=38.0, smooth_s=0.35), key_time=3.4)
 
 
 if __name__ == "__main__":

@@ -9,8 +9,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..geometry import shapes
+from ..geometry.bicycle import Bicyclist
 from ..interactions.aero import AeroParams, Aerodynamics
 from ..interactions.ground import GroundContact, GroundParams
+from ..outputs.render.camera import TrackingCamera
 from ..scene import Scene
 from ..systems.path import Path, PathFollower
 from ..systems.springmass import SpringNetwork
@@ -97,10 +99,29 @@ def scatter(p: LeafParams):
     return np.concatenate(verts), np.concatenate(tris), np.concatenate(veins)
 
 
-def rider_path(r: RiderParams) -> Path:
-    """Constant speed along +x through x = 0 at pass_time; straight lines keep PCHIP exact."""
-    ts = [r.pass_time + r.start / r.speed, r.pass_time, r.pass_time + r.end / r.speed]
-    return Path(ts, [[r.start, 0, 0], [0, 0, 0], [r.end, 0, 0]], name="rider path")
+AUTUMN = ((0.80, 0.28, 0.04), (0.88, 0.55, 0.08), (0.62, 0.16, 0.05), (0.90, 0.72, 0.16),
+          (0.55, 0.30, 0.08))  # linear RGB: orange, amber, red-brown, yellow, brown
+
+
+def autumn(tris, n: int, seed: int) -> np.ndarray:
+    """(n,3) a colour per point: each leaf (a connected piece of the mesh) one of AUTUMN."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    t = np.asarray(tris)
+    a = coo_matrix((np.ones(2 * len(t)), (np.r_[t[:, 0], t[:, 1]], np.r_[t[:, 1], t[:, 2]])),
+                   shape=(n, n))
+    _, label = connected_components(a, directed=False)
+    pick = np.random.default_rng(seed + 1).integers(0, len(AUTUMN), label.max() + 1)
+    return np.asarray(AUTUMN)[pick[label]]
+
+
+def rider_path(r: RiderParams, duration: float = 0.0) -> Path:
+    """Constant speed along +x through x = 0 at pass_time, on to end (m) or, if the run lasts
+    longer, as far as the rider gets by then: the rider never stops. Straight lines keep PCHIP
+    exact."""
+    end = max(r.end, r.speed * (duration - r.pass_time) + 1.0)
+    ts = [r.pass_time + r.start / r.speed, r.pass_time, r.pass_time + end / r.speed]
+    return Path(ts, [[r.start, 0, 0], [0, 0, 0], [end, 0, 0]], name="rider path")
 
 
 def wake(r: RiderParams, path: Path) -> WindField:
@@ -124,9 +145,8 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
     if dt is not None:
         lp = replace(lp, dt=dt)
     scene = Scene("leaves", duration=duration, fps=fps)
-    path = rider_path(params.rider)
-    bv, bt = shapes.bicyclist()
-    rider = scene.add(PathFollower("bicyclist", path, bv, bt, mass=params.rider.mass,
+    path = rider_path(params.rider, duration)
+    rider = scene.add(PathFollower("bicyclist", path, Bicyclist(), mass=params.rider.mass,
                                    dt=1.0 / fps))
     air = scene.add(wake(params.rider, path))
     x, t, vein = scatter(lp)
@@ -137,7 +157,15 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
         stiffen=(vein, lp.vein), dt=lp.dt, integrator=lp.integrator,
         mass_damping=lp.mass_damping, stiffness_damping=lp.stiffness_damping,
         cg_tolerance=lp.cg_tolerance, strain_limit=0.5))
-    ground = scene.add(StaticPlane("ground", size=6.0))
+    leaves.color = autumn(t, len(x), lp.seed)
+    # the road the rider rides (the leaves lie on it) and the grass verges beside it, which
+    # the leaves never reach (no contact joins them)
+    x0, x1 = path.position(path.t0)[0] - 3.0, path.position(path.t1)[0] + 3.0
+    ground = scene.add(StaticPlane("road", extent=(x0, x1, -2.5, 2.5), color=(0.09, 0.09, 0.10),
+                                   material="concrete"))
+    for side in (-1, 1):
+        scene.add(StaticPlane(f"verge{'-+'[side > 0]}", height=-0.01, color=(0.24, 0.36, 0.15),
+                              extent=(x0, x1, *sorted((side * 2.5, side * 14.0)))))
     scene.connect(Aerodynamics("wake-leaves", air, leaves, params.aero, mode="one-way"))
     scene.connect(GroundContact("ground-leaves", ground, leaves, params.ground, mode="one-way"))
     scene.primary = rider
@@ -148,4 +176,7 @@ def build(coupling: str = "one-way", duration: float = 4.0, fps: float = 60.0,
 SPEC = SceneSpec(
     "leaves", "a passing bicyclist's wake stirs up leaves that settle again (one-way)", build,
     LeavesParams, couplings=("one-way",), duration=4.0, fps=60.0,
-    integrators=("explicit", "implicit", "localglobal"))
+    integrators=("explicit", "implicit", "localglobal"),
+    # low over the leaves, panning a little with the rider as he rides through
+    camera=TrackingCamera("bicyclist", offset=(0.5, -4.3, 1.5), target_offset=(0.3, 0.4, 0.35),
+                          axes=(0.15, 0.0, 0.0), fov_deg=40.0, smooth_s=0.3), key_time=1.25)

@@ -9,12 +9,14 @@ import math
 from dataclasses import dataclass
 
 from ..errors import ParameterError
-from ..geometry.basin import BasinParams, basin
+from ..geometry.basin import BasinParams, basin, banks
 from ..interactions.buoyancy import BodyInWater, BuoyancyParams
 from ..interactions.contact import ContactParams, SpherePlaneContact
 from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
 from ..params import param
 from ..scene import Scene
+from ..outputs.render.camera import Camera
+from ..systems.colliders import set_pieces
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
 from ..systems.water import Water, WaterParams
@@ -59,6 +61,11 @@ class PondParams:
     coupling_dt: float = param(2e-3, "s", ge=1e-7, le=0.1)
 
 
+# linear RGB, one per ball: apart from each other, the water and the banks
+BALL_COLORS = ((0.85, 0.38, 0.08), (0.95, 0.80, 0.12), (0.75, 0.12, 0.40), (0.90, 0.90, 0.88),
+               (0.25, 0.25, 0.28))
+
+
 def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
           integrator: str | None = None, dt: float | None = None,
           params: PondParams = PondParams()) -> Scene:
@@ -76,7 +83,10 @@ def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
     scene = Scene("pond", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
     water = scene.add(Water("water", geo.bed, geo.fluid, geo.depth, geo.spacing, geo.origin,
                             wp))
-    floor = scene.add(StaticPlane("bed", height=0.0, size=0.5 * params.basin.size_x))
+    # the water draws its own bed and shore; the grass banks around the basin meet its rim
+    scene.add(set_pieces([banks(geo, "banks", 6.0)])[0])
+    # the flat of the bed under the balls, as a collider (the water's bed mesh draws it)
+    floor = scene.add(StaticPlane("bed", height=0.0, drawn=False))
     level = params.basin.depth
     field = ViscousDragFieldParams(**{**params.field.__dict__, "surface": level,
                                       "gravity": wp.gravity})
@@ -87,7 +97,8 @@ def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
         ball = scene.add(Sphere(f"ball{k}", SphereParams(radius=r, mass=mass, shell=False,
                                                          dt=b.dt),
                                 position=(b.x[k], b.y[k], level + b.height[k] + r)))
-        standin = ViscousDragField(field, r, 4.0 / 3.0 * math.pi * r ** 3)
+        ball.color = BALL_COLORS[k % len(BALL_COLORS)]
+        standin = ViscousDragField(field)
         scene.connect(BodyInWater(f"ball{k}-water", ball, water, params.buoyancy,
                                   mode=coupling, standin=standin))
         scene.connect(SpherePlaneContact(f"ball{k}-bed", ball, floor, params.bed))
@@ -100,4 +111,6 @@ def build(coupling: str = "two-way", duration: float = 4.0, fps: float = 60.0,
 
 SPEC = SceneSpec(
     "pond", "balls of different densities float, bob and sink in a pond (two-way)", build,
-    PondParams, couplings=("two-way", "one-way", "hybrid"), duration=4.0, fps=60.0)
+    PondParams, couplings=("two-way", "one-way", "hybrid"), duration=4.0, fps=60.0,
+    # from the bank, a little above: the pond and its balls fill the frame
+    camera=Camera((1.1, -1.75, 1.05), (0.0, 0.0, 0.25), 45.0), key_time=0.7)

@@ -11,7 +11,7 @@ from ..kernels.rigid import (Body, Wrench, generalized, kinetic_energy, quat_mul
                              quat_to_matrix, rigid_step)
 from .base import GRAVITY, System
 from ..params import param
-from .shape import Shape
+from .shape import Shape, split_color
 from ..geometry.primitive import Primitive
 from .views import BodiesView, RigidParts
 
@@ -58,6 +58,8 @@ class RigidBody(System, RigidParts):
         self._wrench = Wrench(self.force, self.torque, self.kext, self.dext)
         self._gx, self._gv = np.zeros(7), np.zeros(7)
         self.surface = surface
+        self.color = None  # linear RGB as drawn, or (n,3) one per surface vertex
+        self.material = "rubber"
         self._view = BodiesView(self, [name], [surface if surface is not None else
                                                (np.zeros((0, 3)), np.zeros((0, 3), np.int64))],
                                 [primitive], [self._mass], movable=True)
@@ -125,8 +127,10 @@ class RigidBody(System, RigidParts):
         if self.surface is None:
             return []
         v, t = self.surface
-        return [Shape(self.name, "body", verts=np.asarray(v, float), tris=np.asarray(t),
-                      palette="rigid")]
+        color, per_point = split_color(self.color)
+        return [Shape(self.name, "body", color=color, verts=np.asarray(v, float),
+                      tris=np.asarray(t), palette="rigid", point_colors=per_point,
+                      material=self.material)]
 
     # --- measures ------------------------------------------------------------------------------
     def kinetic_energy(self):

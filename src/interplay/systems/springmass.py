@@ -22,7 +22,7 @@ from ..kernels import springs as K
 from ..kernels.contact import colliders as no_colliders
 from ..kernels.subcycle import advance_with_colliders
 from .base import GRAVITY, System, substeps
-from .shape import Shape
+from .shape import Shape, split_color
 from .views import PointsView
 
 INTEGRATORS = ("explicit", "implicit", "localglobal")
@@ -331,10 +331,15 @@ class SpringNetwork(System):
         return self._view
 
     def shapes(self):
+        """A surface (cloth, flags, leaves: double-sided) or cords (a net, a bungee cord) at
+        their drawn width. ``color`` may be one colour or one per point ((n,3): autumn leaves
+        each their own)."""
         anchors = self.a_pos.copy() if len(self.a_pos) else None
+        color, per_point = split_color(self.color)
         if self.triangles is not None:
-            return [Shape(self.name, "surface", color=self.color, triangles=self.triangles,
-                          anchors=anchors, palette="cloth")]
+            return [Shape(self.name, "surface", color=color, triangles=self.triangles,
+                          anchors=anchors, palette="cloth", point_colors=per_point,
+                          material="cloth", double_sided=True)]
         seg = self.segments()
         if self.cord_radius is not None:
             width = 2.0 * self.cord_radius
@@ -343,8 +348,8 @@ class SpringNetwork(System):
             width = float(np.clip(0.08 * np.median(lengths), 0.002, 0.02))
         else:
             width = 0.005
-        return [Shape(self.name, "cords", color=self.color, segments=seg, width=width,
-                      anchors=anchors, palette="cloth")]
+        return [Shape(self.name, "cords", color=color, segments=seg, width=width,
+                      anchors=anchors, palette="cloth", material="cloth")]
 
     def _factors(self, h):
         """The local/global preconditioner for step h (kernels.localglobal.Factors) and the
