@@ -1,4 +1,4 @@
-"""The ``interplay`` command: list, run, compare, fit-standin and view.
+"""The ``interplay`` command: list, run, compare, fit-standin, view; sweep and tune (sweep.py).
 
 Errors a user can cause print one line (no traceback) and exit with status 2.
 """
@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InterplayError, ParameterError
+from .sweep import add_parsers, cmd_sweep, cmd_tune
 
 
 class _Parser(argparse.ArgumentParser):
@@ -83,6 +84,7 @@ def _parser():
     view.add_argument("dir", help="a run directory, e.g. out/basketball/two-way")
     view.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
     view.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    add_parsers(sub, _scene_options, _output_options)
     return ap
 
 
@@ -182,7 +184,7 @@ def cmd_view(args, console):
 
 
 COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit,
-            "view": cmd_view}
+            "view": cmd_view, "sweep": cmd_sweep, "tune": cmd_tune}
 
 
 def main(argv=None) -> int:
@@ -190,14 +192,14 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     console = Console()
     try:
-        COMMANDS[args.command](args, console)
+        code = COMMANDS[args.command](args, console)
     except InterplayError as e:
         print(f"interplay: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("interplay: interrupted", file=sys.stderr)
         return 130
-    return 0
+    return code or 0
 
 
 if __name__ == "__main__":
