@@ -27,6 +27,8 @@ import io
 import os
 import socket
 import tarfile
+import tempfile
+import time
 import traceback
 from collections import deque
 from contextlib import contextmanager
@@ -182,22 +184,25 @@ class RayCluster:
         self.workers = 0
 
     def __enter__(self):
+        # `ray start` turns token authentication on and keeps the token in ~/.ray; a driver
+        # given an address sends it only in token mode, which Ray reads when it is imported
+        self._auth = os.environ.get("RAY_AUTH_MODE")
+        if self._auth is None and (os.environ.get("RAY_AUTH_TOKEN") or (
+                Path.home() / ".ray" / "auth_token").exists()):
+            os.environ["RAY_AUTH_MODE"] = "token"
         try:
             import ray
         except ImportError:
+            self._restore_auth()
             raise InterplayError("--ray needs Ray: pip install 'ray>=2.9' (or `make "
                                  "test-all`), or leave out --ray to use the local cores") from None
         self._ray = ray
-        # `ray start` turns token authentication on and keeps the token in ~/.ray; a driver
-        # given an address sends it only when told to
-        if "RAY_AUTH_MODE" not in os.environ and (os.environ.get("RAY_AUTH_TOKEN") or (
-                Path.home() / ".ray" / "auth_token").exists()):
-            os.environ["RAY_AUTH_MODE"] = "token"
         env = {"env_vars": dict(WORKER_ENV)}
         try:
             ray.init(address=self.address, runtime_env=env, include_dashboard=False,
                      log_to_driver=False, configure_logging=False)
         except (ConnectionError, ValueError, RuntimeError) as e:
+            self._restore_auth()
             raise InterplayError(f"--ray {self.address or ''}: cannot connect to a Ray cluster "
                                  f"({str(e).splitlines()[0]}); start one with `ray start "
                                  "--head` or give its ADDRESS (host:port), and its token "
@@ -207,7 +212,7 @@ class RayCluster:
         info = ray.get(self._remote.remote(_probe, None))
         if isinstance(info, Failure) or info["code"] != code_digest():
             got = info.message if isinstance(info, Failure) else f"code {info['code']}"
-            ray.shutdown()
+            self.__exit__(None, None, None)
             raise InterplayError(f"the Ray cluster runs a different Interplay ({got}; this "
                                  f"one is {code_digest()}): install the same version on every "
                                  "node, or leave out --ray")
@@ -215,6 +220,11 @@ class RayCluster:
 
     def __exit__(self, *exc):
         self._ray.shutdown()
+        self._restore_auth()
+
+    def _restore_auth(self):
+        if self._auth is None:
+            os.environ.pop("RAY_AUTH_MODE", None)
 
     def map_unordered(self, fn, items):
         ray = self._ray
@@ -236,6 +246,47 @@ class RayCluster:
 
 def _probe(_):
     return worker_info()
+
+
+@contextmanager
+def local_ray_head(cpus: int = 2, env: dict | None = None, timeout_s: float = 180.0):
+    """A one-node Ray cluster on this machine (``ray start --head --block``) for tests and
+    benchmarks; yields its address. It runs in its own session and is stopped by signalling
+    that process group (``ray stop`` would stop every Ray cluster on the machine). env: extra
+    environment for it and its workers (e.g. PYTHONPATH)."""
+    import shutil
+    import signal
+    import subprocess
+    import sys
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    tmp = Path(tempfile.mkdtemp(prefix="ipray"))  # short: Ray's socket paths fit in 107 bytes
+    log = tmp / "head.log"
+    ray_cli = shutil.which("ray") or str(Path(sys.executable).parent / "ray")
+    with open(log, "w") as fh:
+        proc = subprocess.Popen([ray_cli, "start", "--head", f"--port={port}",
+                                 f"--num-cpus={cpus}", "--include-dashboard=false",
+                                 "--disable-usage-stats", f"--temp-dir={tmp}", "--block"],
+                                env={**os.environ, **(env or {})}, stdout=fh,
+                                stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        deadline = time.monotonic() + timeout_s
+        while "Ray runtime started" not in log.read_text():
+            if proc.poll() is not None or time.monotonic() > deadline:
+                raise InterplayError(f"ray start --head did not start: "
+                                     f"{log.read_text()[-500:]}")
+            time.sleep(0.5)
+        yield f"127.0.0.1:{port}"
+    finally:
+        os.killpg(proc.pid, signal.SIGTERM)
+        try:
+            proc.wait(5)
+        except subprocess.TimeoutExpired:
+            pass
+        os.killpg(proc.pid, signal.SIGKILL)  # what SIGTERM left (the raylet is slow to go)
+        proc.wait()
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def check_workers(workers) -> int:

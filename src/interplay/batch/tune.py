@@ -136,10 +136,10 @@ def run_search(base: RunRequest, name: str | None, out, executor, budget: int | 
                 record(todo[i], value)
         losses = [math.inf if cache[c.id]["loss"] is None else cache[c.id]["loss"]
                   for c in cands]
-        g = state["generation"]
-        best = min(losses)
-        log(f"generation {g}/{generations}: best of batch {best:.6g}"
-            + (f" ({len(cands) - len(todo)} from the log)" if len(todo) < len(cands) else ""))
+        state["best"] = min(state.get("best", math.inf), *losses)
+        log(f"generation {state['generation']}/{generations}: {len(todo)} evaluated"
+            + (f", {len(cands) - len(todo)} from the log" if len(todo) < len(cands) else "")
+            + f"; best loss so far {state['best']:.6g}")
         state["generation"] += 1
         return losses
 

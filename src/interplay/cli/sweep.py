@@ -69,7 +69,7 @@ def _request(args):
 def _log(args, console):
     if args.quiet:
         return lambda line: None
-    return lambda line: console.print(line, markup=False, highlight=False)
+    return lambda line: console.print(line, markup=False, highlight=False, soft_wrap=True)
 
 
 def cmd_sweep(args, console) -> int:
@@ -125,8 +125,10 @@ def cmd_tune(args, console) -> int:
                      _log(args, console))
     console.print(f"{doc['scene']} {doc['search']}: loss {doc['start_loss']:.6g} at the start, "
                   f"{doc['loss']:.6g} at the best ({doc['evaluations']} evaluations, "
-                  f"{doc['from_log']} from the log, {doc['wall_s']:.1f} s)", markup=False)
+                  f"{doc['from_log']} from the log, {doc['wall_s']:.1f} s)", markup=False,
+                  soft_wrap=True)
     console.print(f"run it: interplay run {doc['scene']} "
-                  + " ".join(f"--set {s}" for s in (*base.sets, *doc["set"])), markup=False)
+                  + " ".join(f"--set {s}" for s in (*base.sets, *doc["set"])), markup=False,
+                  soft_wrap=True)
     console.print(f"wrote {out / 'tune.json'}", markup=False)
     return 0
