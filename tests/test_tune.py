@@ -21,11 +21,18 @@ def tune(out, *extra):
     return json.loads((out / "tune.json").read_text())
 
 
-def test_same_seed_same_search_on_one_and_two_workers(tmp_path):
+@pytest.fixture(scope="module")
+def on_two(tmp_path_factory):
+    """The search on two workers: (its folder, its tune.json)."""
+    out = tmp_path_factory.mktemp("two")
+    return out, tune(out, "--workers", "2")
+
+
+def test_same_seed_same_search_on_one_and_two_workers(tmp_path, on_two):
     """The bungee leap's search (the figure alone, 5 leaps per evaluation): 4 chains, 2
     generations, the same candidates and losses in the same order whatever the workers."""
     one = tune(tmp_path / "one", "--workers", "1")
-    two = tune(tmp_path / "two", "--workers", "2")
+    two = on_two[1]
     assert one["best"] == two["best"] and one["loss"] == two["loss"]
     assert one["history"] == two["history"] and len(one["history"]) == 9
     assert one["ran"] == two["ran"] == 9 and one["from_log"] == 0
@@ -37,13 +44,13 @@ def test_same_seed_same_search_on_one_and_two_workers(tmp_path):
     assert one["start_loss"] == B.leap_loss(B.JumperParams())
 
 
-def test_interrupted_search_resumes_from_its_log(tmp_path):
+def test_interrupted_search_resumes_from_its_log(tmp_path, on_two):
     """A search killed after 5 of its 9 evaluations (the log cut there, its last line half
     written) reruns only the 4 missing ones and ends where the uninterrupted search does."""
-    full = tune(tmp_path / "full", "--workers", "2")
+    folder, full = on_two
     cut = tmp_path / "cut"
     cut.mkdir()
-    lines = (tmp_path / "full" / "evaluations.jsonl").read_text().splitlines()
+    lines = (folder / "evaluations.jsonl").read_text().splitlines()
     (cut / "evaluations.jsonl").write_text("\n".join(lines[:5]) + "\n" + lines[5][:40])
     again = tune(cut, "--workers", "2")
     assert again["from_log"] == 5 and again["ran"] == 4
