@@ -212,3 +212,29 @@ def test_local_pool_survives_a_dead_worker():
     assert {i: got[i] for i in (0, 2, 4, 5)} == {0: 2, 2: 6, 4: 10, 5: 12}
     assert isinstance(got[1], Failure) and got[1].kind == "worker"
     assert isinstance(got[3], Failure) and got[3].message == "ValueError: bad item"
+
+
+@pytest.mark.slow
+def test_contact_sheet_shows_every_still_and_sorts_in_chromium(tmp_path):
+    from test_outputs_browser import Browser
+    out = tmp_path / "sweep"
+    assert cli("sweep", "basketball", *WEDGE, *QUICK, "--quiet", "--out", str(out)) == 0
+    b = Browser()
+    try:
+        b.call("Page.navigate", url=(out / "contact_sheet.html").as_uri())
+        assert b.wait_for("document.readyState === 'complete'")
+        assert b.wait_for("document.images.length === 4 && [...document.images].every("
+                          "i => i.complete && i.naturalWidth === 480)"), "a still did not load"
+        col = b.eval("[...document.querySelectorAll('#sheet th')].findIndex("
+                     "th => th.textContent === 'force max (N)')")
+        column = (f"[...document.querySelectorAll('#sheet tbody tr')].map("
+                  f"r => parseFloat(r.cells[{col}].dataset.v))")
+        b.eval(f"document.querySelectorAll('#sheet th')[{col}].click()")
+        up = b.eval(column)
+        b.eval(f"document.querySelectorAll('#sheet th')[{col}].click()")
+        down = b.eval(column)
+        assert up == sorted(up) and down == sorted(up, reverse=True) and up != down
+        b.pump(0.5)
+        assert b.errors() == []
+    finally:
+        b.close()

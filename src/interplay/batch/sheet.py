@@ -75,7 +75,7 @@ def _cell(v) -> tuple[str, str]:
     if isinstance(v, (int, float)):
         return f"{v:.4g}", repr(float(v))
     if isinstance(v, list) and v and all(isinstance(x, (int, float)) for x in v):
-        return ", ".join(f"{x:.3g}" for x in v), repr(float(np.linalg.norm(v)))
+        return ", ".join(f"{x:.2f}" for x in v), repr(float(np.linalg.norm(v)))  # by length
     return str(v), str(v)
 
 
@@ -125,11 +125,18 @@ def write_sheet(out: Path, doc: dict, stills: dict) -> Path:
     title = f"{doc['scene']} sweep: {len(doc['variants'])} variants"
     page = PAGE.format(title=html.escape(title), head=head, body="\n".join(body),
                        counts=html.escape(", ".join(f"{v} {k}" for k, v in counts.items())),
-                       base=html.escape(json.dumps(doc.get("base", {}))))
+                       base=html.escape(_base(doc.get("base", {}))))
     path = out / SHEET
     with atomic_path(path) as tmp:
         tmp.write_text(page)
     return path
+
+
+def _base(base: dict) -> str:
+    """The base run as its command line."""
+    opts = [f"--{k} {v}" for k, v in base.items() if k not in ("scene", "sets") and v is not None]
+    return " ".join(["interplay run", str(base.get("scene", "")), *opts,
+                     *(f"--set {s}" for s in base.get("sets", ()))])
 
 
 PAGE = """<!doctype html>
@@ -144,7 +151,7 @@ td img {{ width: 240px; display: block; }}
 tr.error td {{ background: #fbe9e7; }} tr.pending td {{ color: #999; }}
 </style></head><body>
 <h1>{title}</h1>
-<p>{counts}. Base run: <code>{base}</code>. Click a heading to sort; click a still for the
+<p>{counts}. Every variant is <code>{base}</code> with its own values. Click a heading to sort; click a still for the
 variant's report. Force and acceleration: the main interaction over its contact period (the
 paper's Table I).</p>
 <table id="sheet"><thead><tr>{head}</tr></thead><tbody>

@@ -51,7 +51,7 @@ def run_variant(task: VariantTask) -> dict:
         spec, coupling, kw = v.request.resolve()
         result = run_scene(spec, coupling, kw, quiet=True)
         t1 = time.perf_counter()
-        options = replace(task.options, timings={})  # each run its own timings
+        options = replace(task.options, timings={}, quiet=True)  # its own timings; no bars
         write_outputs(result, part, options, scene_summary(spec, result))
         summary = json.loads((part / "summary.json").read_text())  # the row: saved data
         timings = {"simulate_s": result.total_s, **{k: v for k, v in result.timings().items()
