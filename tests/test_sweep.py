@@ -18,7 +18,7 @@ from interplay.batch import variants as V
 from interplay.batch.executor import Failure, LocalPool
 from interplay.batch.sweep import run_sweep
 from interplay.cli.command import main
-from interplay.scenes import spec
+from interplay.scenes import all_specs, spec
 
 QUICK = ["--duration", "0.5", "--no-video", "--no-obj", "--no-usd", "--no-report"]
 WEDGE = ["--vary", "net.cord_ea=150,300", "--vary", "contact.friction=0.2,0.6"]
@@ -238,3 +238,14 @@ def test_contact_sheet_shows_every_still_and_sorts_in_chromium(tmp_path):
         assert b.errors() == []
     finally:
         b.close()
+
+
+@pytest.mark.parametrize("name", [s.name for s in all_specs()])
+def test_results_are_data_that_cross_a_process_boundary(name):
+    """A Result pickles (what an executor's task may return) and its copy analyses the same."""
+    import pickle
+    s = spec(name)
+    r = s.build(s.default_coupling, duration=0.1, fps=s.fps, params=s.params()).simulate()
+    copy = pickle.loads(pickle.dumps(r))
+    assert copy.summary()["interactions"] == r.summary()["interactions"]
+    assert copy.summary()["diagnostics"] == r.summary()["diagnostics"]
