@@ -37,7 +37,8 @@ DESIGNS = ("lhs", "random")
 class RunRequest:
     """What ``interplay run`` is asked, as data: scene, coupling (None: the scene's default),
     sets ("KEY=VALUE" strings, applied in order), duration (s), fps, integrator, dt (s);
-    None takes the scene's own."""
+    None takes the scene's own; force: run past the cost budget (``--force``; it decides
+    whether a run starts, not its result, so it is not part of a run's id)."""
     scene: str
     coupling: str | None = None
     sets: tuple = ()
@@ -45,6 +46,7 @@ class RunRequest:
     fps: float | None = None
     integrator: str | None = None
     dt: float | None = None
+    force: bool = False
 
     def with_values(self, values: dict) -> "RunRequest":
         """This request with a variant's values: run options replaced, parameters appended
@@ -59,7 +61,8 @@ class RunRequest:
         it (the same code: the results are the same)."""
         from ..cli.command import _build_kwargs
         ns = argparse.Namespace(scene=self.scene, sets=list(self.sets), duration=self.duration,
-                                fps=self.fps, integrator=self.integrator, dt=self.dt)
+                                fps=self.fps, integrator=self.integrator, dt=self.dt,
+                                force=self.force, help_params=None)
         spec, kw = _build_kwargs(ns)
         return spec, spec.check_coupling(self.coupling), kw
 

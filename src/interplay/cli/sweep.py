@@ -63,7 +63,7 @@ def _executor_options(g):
 def _request(args):
     from ..batch.variants import RunRequest
     return RunRequest(args.scene, args.coupling, tuple(args.sets), args.duration, args.fps,
-                      args.integrator, args.dt)
+                      args.integrator, args.dt, bool(getattr(args, "force", False)))
 
 
 def _log(args, console):
