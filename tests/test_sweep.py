@@ -153,6 +153,8 @@ BAD = [
     (["--sample", "net.integrator=0:1", "--samples", "4"], "net.integrator is not a number"),
     (["--vary", "ball.mass=0.6,0.7", "--vary", "ball.mass=0.8"], "ball.mass: varied twice"),
     ([], "nothing to vary"),
+    (["--sample", "ball.mass=0.5:0.7", "--samples", "4", "--design", "sobol"],
+     "--design sobol: choose lhs or random"),
     (["--vary", "ball.mass=0.6,0.7", "--workers", "0"], "--workers 0: need a whole number"),
     (["--vary", "ball.mass=0.6,0.7", "--still-at", "9"], "--still-at 9: choose a time"),
     (["--vary", "ball.mass=0.6,0.7", "--workers", "2", "--ray"], "leave out one of --workers"),

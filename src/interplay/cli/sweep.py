@@ -24,7 +24,8 @@ def add_parsers(sub, scene_options, output_options):
                         "/; several --vary make a grid")
     g.add_argument("--sample", action="append", default=[], metavar="KEY=LO:HI",
                    help="a range to draw --samples values from")
-    g.add_argument("--samples", type=int, default=None, metavar="N")
+    g.add_argument("--samples", type=int, default=None, metavar="N",
+                   help="how many points the --sample ranges give")
     g.add_argument("--seed", type=int, default=0, help="the samples' seed")
     g.add_argument("--design", default="lhs", metavar="lhs|random",
                    help="Latin hypercube (default) or uniform random samples")
