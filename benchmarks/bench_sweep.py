@@ -9,7 +9,8 @@ the workers' start to the last variant's folder; the contact sheet's stills, dra
 by the driver, are not.
 
 speed_up = median T(1 worker) / median T(2 workers), the repeats interleaved (1, 2, 1, 2, ...)
-so that both see the same machine load (loadavg recorded with every sample). Ray: a one-node
+so that both see the same machine load (loadavg recorded with every sample, and the cores the
+sweep actually got: its CPU time over its wall time). Ray: a one-node
 cluster of 2 CPUs started here (``local_ray_head``); T(ray) covers connecting, the code check,
 Ray's workers starting, the 8 variants and gathering their folders into DIR; overhead per
 variant = (median T(ray) - median T(2 workers)) / 8. Wall-clock on a shared 2-core machine:
@@ -21,6 +22,7 @@ from __future__ import annotations
 import common  # noqa: F401  (thread settings first)
 
 import os  # noqa: E402
+import resource  # noqa: E402
 import shutil  # noqa: E402
 import statistics  # noqa: E402
 import tempfile  # noqa: E402
@@ -37,23 +39,35 @@ from interplay.outputs.writer import OutputOptions  # noqa: E402
 VARIANTS = 8
 
 
+def cpu_s() -> float:
+    """CPU time (s) of this process and its reaped children (a local pool's workers)."""
+    return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                 resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
 def timed_sweep(variants, executor, root: Path) -> dict:
+    """One sweep into a fresh folder: wall time, the variants' own wall times summed, the
+    CPU time it got (this process and the pool's workers; Ray's are not our children) over
+    the wall time, i.e. how many cores it had on average, and the 1-minute load before."""
     out = Path(tempfile.mkdtemp(dir=root))
     load = os.getloadavg()[0]
-    t0 = time.perf_counter()
+    c0, t0 = cpu_s(), time.perf_counter()
     doc = run_sweep(variants, out, OutputOptions(quiet=True), executor,
                     {"scene": "basketball", "keys": ["net.cord_ea"]}, log=lambda m: None)
     wall = time.perf_counter() - t0
+    cores = (cpu_s() - c0) / wall if executor.kind == "local" else None
     assert doc["counts"]["ok"] == len(variants), doc["counts"]
     per = [r["timings"]["wall_s"] for r in doc["variants"]]
     shutil.rmtree(out)
-    return {"wall_s": wall, "variant_wall_s_sum": sum(per), "load_1min": load}
+    return {"wall_s": wall, "variant_wall_s_sum": sum(per), "cores_used": cores,
+            "load_1min": load}
 
 
 def summarise(samples: list) -> dict:
     return {**common.stats([s["wall_s"] for s in samples]),
             "variant_wall_s_sum_median": statistics.median(s["variant_wall_s_sum"]
                                                            for s in samples),
+            "cores_used": [s["cores_used"] for s in samples],
             "load_1min": [s["load_1min"] for s in samples]}
 
 
@@ -74,8 +88,9 @@ def main():
         for _ in range(repeats):
             for n in (1, 2):
                 runs[n].append(timed_sweep(variants, LocalPool(n), root))
-                print(f"{n} worker(s): {runs[n][-1]['wall_s']:.2f} s "
-                      f"(load {runs[n][-1]['load_1min']:.2f})", flush=True)
+                r = runs[n][-1]
+                print(f"{n} worker(s): {r['wall_s']:.2f} s, {r['cores_used']:.2f} cores "
+                      f"(load {r['load_1min']:.2f})", flush=True)
         local = {f"workers_{n}": summarise(s) for n, s in runs.items()}
         local["speed_up"] = local["workers_1"]["median"] / local["workers_2"]["median"]
         local["target_speed_up"] = 1.7
