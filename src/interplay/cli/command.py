@@ -1,4 +1,4 @@
-"""The ``interplay`` command: list, run, compare, fit-standin and view.
+"""The ``interplay`` command: list, run, compare, fit-standin, view; sweep and tune (sweep.py).
 
 Errors a user can cause print one line (no traceback) and exit with status 2.
 """
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from .. import params as P
 from ..errors import CostError, InterplayError, ParameterError, StabilityError
 from ..params import param
+from .sweep import add_parsers, cmd_sweep, cmd_tune
 
 
 #: the smallest preview the captions fit in (the overlay's text is ~130 px wide, 34 px high)
@@ -143,6 +144,7 @@ def _parser():
     view.add_argument("dir", help="a run directory, e.g. out/basketball/two-way")
     view.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
     view.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    add_parsers(sub, _scene_options, _output_options)
     return ap
 
 
@@ -337,7 +339,7 @@ def cmd_view(args, console):
 
 
 COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit,
-            "view": cmd_view}
+            "view": cmd_view, "sweep": cmd_sweep, "tune": cmd_tune}
 
 
 def _argv(argv):
@@ -394,7 +396,7 @@ def main(argv=None) -> int:
         previous = None
     quiet_mujoco()
     try:
-        COMMANDS[args.command](args, console)
+        code = COMMANDS[args.command](args, console)
     except InterplayError as e:
         print(f"interplay: error: {e}", file=sys.stderr)
         return 2
@@ -413,7 +415,7 @@ def main(argv=None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
-    return 0
+    return code or 0
 
 
 if __name__ == "__main__":
