@@ -253,3 +253,10 @@ def test_results_are_data_that_cross_a_process_boundary(name):
     copy = pickle.loads(pickle.dumps(r))
     assert copy.summary()["interactions"] == r.summary()["interactions"]
     assert copy.summary()["diagnostics"] == r.summary()["diagnostics"]
+
+
+def test_help_params_lists_what_a_wedge_may_vary(capsys):
+    """`interplay sweep SCENE --help-params json` is the scene's parameter schema, nothing run."""
+    assert cli("sweep", "basketball", "--help-params", "json") == 0
+    schema = json.loads(capsys.readouterr().out)
+    assert schema["properties"]["net"]["properties"]["cord_ea"]["x-unit"] == "N"

@@ -48,7 +48,7 @@ def run_variant(task: VariantTask) -> dict:
     timings = {}
     try:
         spec, coupling, kw = v.request.resolve()
-        result = run_scene(spec, coupling, kw, quiet=True)
+        result = run_scene(spec, coupling, kw, quiet=True, force=v.request.force)
         t1 = time.perf_counter()
         options = replace(task.options, timings={}, quiet=True)  # its own timings; no bars
         write_outputs(result, part, options, scene_summary(spec, result))

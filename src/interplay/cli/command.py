@@ -405,6 +405,9 @@ def main(argv=None) -> int:
         print(f"interplay: {how}; `interplay run ... --resume` continues from the last "
               "checkpoint", file=sys.stderr)
         return 143 if isinstance(e, Terminated) else 130
+    except BrokenPipeError:  # the reader (head, less) stopped reading: not a failure
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except Exception as e:  # noqa: BLE001 - a bug, not the user's input: one line, exit 3
         if os.environ.get("INTERPLAY_DEBUG"):
             raise

@@ -76,6 +76,10 @@ def _log(args, console):
 def cmd_sweep(args, console) -> int:
     from dataclasses import asdict
 
+    from .command import _help_params
+    if _help_params(args, console):  # the keys a wedge may vary
+        return 0
+
     from ..batch.executor import make_executor
     from ..batch.sheet import render_stills, write_sheet
     from ..batch.sweep import run_sweep
@@ -115,6 +119,9 @@ def cmd_sweep(args, console) -> int:
 
 
 def cmd_tune(args, console) -> int:
+    from .command import _help_params
+    if _help_params(args, console):
+        return 0
     from ..batch.executor import make_executor
     from ..batch.tune import run_search
     from ..outputs.writer import ensure_writable
