@@ -117,7 +117,7 @@ def test_no_video_report_says_so(tmp_path, capsys):
     (["--camera", "0,0,1:0,0,1"], "same point"),
     (["--size", "big"], "--size big: expected WIDTHxHEIGHT"),
     (["--size", "321x200"], "must be even"),
-    (["--video-fps", "0"], "--video-fps 0: choose 1 to 240"),
+    (["--video-fps", "0"], "--video-fps 0: out of range; --video-fps must be a finite number >= 1 and <= 240"),
 ])
 def test_bad_output_options_fail_in_one_line(tmp_path, capsys, args, words):
     code, out, err = run_cli(capsys, "run", "basketball", "--out", str(tmp_path), *args)

@@ -25,11 +25,12 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
         results[mode] = run_scene(spec, mode, kw, quiet)
     reference = results.get("two-way")
     one_way_stable = (not any(results["one-way"].warnings)) if "one-way" in results else None
-    two_way_cost = reference.total_s if reference is not None else None
+    two_way_cost = reference.work if reference is not None else None
+    wall = reference.total_s - reference.compile_s if reference is not None else None
     rows, paths = {}, []
     for mode, r in results.items():
         summary = scene_summary(spec, r, one_way_stable=one_way_stable,
-                                two_way_cost_s=two_way_cost)
+                                two_way_work=two_way_cost, two_way_wall_s=wall)
         if options is None:
             paths += r.save(out / mode, summary)
         else:
@@ -37,7 +38,8 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
             paths += write_outputs(r, out / mode, options, summary)
         rows[mode] = mode_row(r, summary.get("figures", {}))
     first = reference or next(iter(results.values()))
-    advice = first.advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
+    advice = first.advice(one_way_stable=one_way_stable, two_way_work=two_way_cost,
+                          two_way_wall_s=wall)
     report = {"scene": spec.name, "modes": rows, "advice": advice}
     path = out / "compare.json"
     with atomic_path(path) as tmp:
@@ -48,7 +50,7 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
         paths += write_compare_outputs(results, out, rows, advice, options)
     _print_table(console, rows, advice)
     for p in paths:
-        console.print(f"wrote {p}")
+        console.print(f"wrote {p}", markup=False, soft_wrap=True)
     return report
 
 

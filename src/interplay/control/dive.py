@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..geometry.anthropometry import SEGMENTS, BodyParams
+from ..params import param
 from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from . import behaviours as B
@@ -52,24 +53,25 @@ class DiveParams:
     edge, before the pike (rad of hip flexion in the air); open, open_flat: the trunk's
     forward pitch (rad from upright) at which he opens out, or will within spot (s) at the
     rate he turns. The defaults were found by ``tune`` (docs/diver.md)."""
-    mass: float = 64.38  # kg
-    height: float = 1.70  # m
-    entry: str = "rip"
-    stand: float = 0.3  # s
-    crouch: float = 0.6  # s
-    depth: float = 0.6
-    lean: float = 0.327  # rad
-    tip_ankle: float = 0.52  # rad
-    lead: float = 0.106  # m
-    hip: float = -0.101  # rad
-    power: float = 0.83
-    arm_swing: float = 2.692  # rad
-    push: float = 0.1  # s
-    reach: float = 0.217  # s
-    pike: float = 1.905  # rad
-    open: float = 2.99  # rad
-    spot: float = 0.0  # s
-    open_flat: float = 1.2  # rad
+    # the domains are the bungee jumper's (the same figure and leap, scenes/bungee.py)
+    mass: float = param(64.38, "kg", ge=10.0, le=500.0)
+    height: float = param(1.70, "m", ge=0.5, le=3.0)
+    entry: str = "rip"  # checked by validated(), with what each entry is
+    stand: float = param(0.3, "s", ge=0.0, le=100.0)
+    crouch: float = param(0.6, "s", ge=0.0, le=100.0)
+    depth: float = param(0.6, "-", ge=0.0, le=2.0)
+    lean: float = param(0.327, "rad", ge=-1.6, le=1.6)
+    tip_ankle: float = param(0.52, "rad", ge=-1.6, le=1.6)
+    lead: float = param(0.106, "m", ge=-1.0, le=1.0)
+    hip: float = param(-0.101, "rad", ge=-1.6, le=2.6)
+    power: float = param(0.83, "-", ge=0.0, le=5.0)
+    arm_swing: float = param(2.692, "rad", ge=-3.2, le=3.2)
+    push: float = param(0.1, "s", ge=0.0, le=100.0)
+    reach: float = param(0.217, "s", ge=0.0, le=100.0)
+    pike: float = param(1.905, "rad", ge=-3.2, le=3.2)
+    open: float = param(2.99, "rad", ge=0.0, le=3.2)
+    spot: float = param(0.0, "s", ge=0.0, le=10.0)
+    open_flat: float = param(1.2, "rad", ge=0.0, le=3.2)
 
     def validated(self) -> "DiveParams":
         if self.entry not in ENTRIES:
@@ -232,7 +234,6 @@ def fly(fig: Figure, standin, level: float, duration: float, h: float = 2e-3,
 
 
 # --- the search (``python -m interplay.control.dive``) ------------------------------------------
-TUNED = ("lean", "lead", "hip", "power", "arm_swing", "reach", "pike", "open", "spot")
 BOUNDS = {"lean": (0.0, 0.8), "lead": (0.0, 0.3), "hip": (-0.2, 1.4), "power": (0.5, 2.0),
           "arm_swing": (1.0, 3.0), "reach": (0.0, 0.5), "pike": (1.2, 2.1),
           "open": (1.5, 3.1), "spot": (0.0, 0.6)}
@@ -255,22 +256,12 @@ def dive_loss(trial: Trial, edge: float) -> float:
             + 2.0 * max(0.0, CLEAR - (e.point[0] - edge)) + min(50.0 * trial.touched, 20.0))
 
 
-def tune(make, edge: float, level: float, evaluations: int = 150, seed: int = 0,
-         start: DiveParams = DiveParams(), duration: float = 5.0, **anneal_kw):
-    """Simulated annealing (control/search.py ``anneal``, its settings in anneal_kw) over
-    TUNED, each evaluation the dive and its NUDGES flown in air to the water (no stand-in is
-    needed before the entry). make(p) -> Figure builds the diver on his platform. Returns the
-    best DiveParams and the SearchResult."""
-    from .search import anneal
-
-    def loss(d):
-        total = 0.0
-        for nudge in NUDGES:
-            q = replace(start, **d)
-            q = replace(q, **{k: getattr(q, k) + dv for k, dv in nudge})
-            total += dive_loss(fly(make(q), None, level, duration), edge)
-        return total / len(NUDGES)
-
-    res = anneal(loss, {k: getattr(start, k) for k in TUNED}, BOUNDS, evaluations, seed,
-                 **anneal_kw)
-    return replace(start, **res.best), res
+def nudged_loss(make, p: DiveParams, edge: float, level: float, duration: float = 5.0) -> float:
+    """dive_loss averaged over the dive p and its NUDGES, each flown in air to the water (no
+    stand-in is needed before the entry), so the optimum is not a knife edge. make(p) ->
+    Figure builds the diver on his platform."""
+    total = 0.0
+    for nudge in NUDGES:
+        q = replace(p, **{k: getattr(p, k) + dv for k, dv in nudge})
+        total += dive_loss(fly(make(q), None, level, duration), edge)
+    return total / len(NUDGES)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
+from ..params import param
 
 SHAPES = ("ellipse", "rectangle")
 
@@ -17,13 +18,20 @@ class BasinParams:
     along x (the spacing is size_x / cells); depth: still water over the flat bed at z = 0 (m);
     shore: width (m) of the bed's slope up to the rim; rim: height of the bed at the rim as a
     multiple of depth (> 1 leaves a dry beach); shape: ellipse or rectangle."""
-    size_x: float = 2.0  # m
-    size_y: float = 2.0  # m
-    cells: int = 128
-    depth: float = 0.3  # m
-    shore: float = 0.3  # m
-    rim: float = 1.3  # x depth
-    shape: str = "ellipse"
+    size_x: float = param(2.0, "m", ge=0.01, le=1000.0, doc="grid extent along x")
+    size_y: float = param(2.0, "m", ge=0.01, le=1000.0, doc="grid extent along y")
+    # columns along x; along y in proportion: cells^2 size_y / size_x columns in all
+    cells: int = param(128, "columns", ge=4, le=4096, cost=("columns", 2))
+    depth: float = param(0.3, "m", ge=1e-3, le=100.0, doc="still water over the flat bed")
+    shore: float = param(0.3, "m", ge=0.0, le=1000.0, doc="width of the sloping shore")
+    rim: float = param(1.3, "x depth", ge=1.0, le=100.0, doc="bed height at the rim")
+    shape: str = param("ellipse", choices=SHAPES)
+
+    def __post_init__(self):
+        # the column count is cells^2 size_y / size_x: bound the aspect so cells bounds it
+        if not 0.01 <= self.size_y / self.size_x <= 100.0:
+            raise ParameterError(f"size_y / size_x = {self.size_y / self.size_x:.3g} must be "
+                                 "within 0.01 to 100 (a basin, not a channel)")
 
 
 @dataclass(frozen=True)

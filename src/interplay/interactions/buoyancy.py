@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative
+from ..params import param
 from .base import Interaction
 from .immersion import ImmersedParts
 
@@ -50,11 +51,11 @@ class BuoyancyParams:
     sphere or ellipsoid; normal_drag C_n of a capsule broadside and of a box's faces (a blunt
     body); axial_drag C_a of a capsule end-on (a rounded nose); rotational_drag C_r of a
     spinning sphere; added_mass C_a (-, 0.5 for a sphere, 0 off)."""
-    drag: float = 0.47
-    normal_drag: float = 1.0
-    axial_drag: float = 0.3
-    rotational_drag: float = 0.5
-    added_mass: float = 0.0
+    drag: float = param(0.47, "-", ge=0.0, le=100.0, doc="C_d of a sphere or ellipsoid")
+    normal_drag: float = param(1.0, "-", ge=0.0, le=100.0, doc="C_n of a capsule broadside")
+    axial_drag: float = param(0.3, "-", ge=0.0, le=100.0, doc="C_a of a capsule end-on")
+    rotational_drag: float = param(0.5, "-", ge=0.0, le=100.0, doc="C_r")
+    added_mass: float = param(0.0, "-", ge=0.0, le=10.0, doc="C_a (0.5 for a sphere)")
 
     def validated(self, owner):
         for name in ("drag", "normal_drag", "axial_drag", "rotational_drag", "added_mass"):

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import require_nonnegative
+from ..params import param
 from ..kernels.contact import sphere_segment_overlap
 from ..kernels.lids import submerged
 from .base import StandIn
@@ -24,8 +25,10 @@ class DampingFieldParams:
     rest-shape cords the ball penetrates of (penetration depth / ball radius). The defaults are
     fitted to the default two-way basketball (``interplay fit-standin basketball``).
     """
-    linear: float = 0.2062  # fitted: `interplay fit-standin basketball` (docs/coupling.md)
-    angular: float = 0.0  # the default ball enters without spin; a field cannot create spin
+    # fitted: `interplay fit-standin basketball` (docs/coupling.md)
+    linear: float = param(0.2062, "N s/m", ge=0.0, le=1e6, doc="per unit overlap")
+    # the default ball enters without spin; a field cannot create spin
+    angular: float = param(0.0, "N m s", ge=0.0, le=1e6, doc="per unit overlap")
     enabled: bool = True
 
 
@@ -66,11 +69,11 @@ class ViscousDragFieldParams:
     quadratic (N s^2/m^2) drag on each part at full submersion, scaled by its submerged
     fraction; density (kg/m^3): > 0 adds buoyancy density g V_sub (Archimedes at the still
     surface), 0 leaves it out (a pure damping field); gravity (m/s^2)."""
-    surface: float = 0.0  # m
-    linear: float = 2.0  # N s/m
-    quadratic: float = 20.0  # N s^2/m^2
-    density: float = 0.0  # kg/m^3
-    gravity: float = 9.81  # m/s^2
+    surface: float = param(0.0, "m", ge=-1e4, le=1e4, doc="still surface height")
+    linear: float = param(2.0, "N s/m", ge=0.0, le=1e6)
+    quadratic: float = param(20.0, "N s^2/m^2", ge=0.0, le=1e6)
+    density: float = param(0.0, "kg/m^3", ge=0.0, le=1e5, doc="0: no buoyancy")
+    gravity: float = param(9.81, "m/s^2", ge=0.0, le=100.0)
     enabled: bool = True
 
 

@@ -114,25 +114,43 @@ def _timed(timings, key, fn, *args, **kw):
 
 
 def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
-                  summary: dict | None = None) -> list[Path]:
-    """Write every output of one run into out_dir; return the paths, in order.
+                  summary: dict | None = None, run_id: str | None = None,
+                  request: dict | None = None, locked: bool = False) -> list[Path]:
+    """Write every output of one run into out_dir as one unit (outputs/runfolder.py: staged,
+    then published under a manifest with the run id); return the final paths, in order.
 
     summary: the dict to save as summary.json (default ``result.summary()``). Wall times of
     each output land in ``options.timings`` (s): save_s (summary, tracks, scene.json), usd_s,
     obj_s, plots_s, video_render_s and video_encode_s (inside the renderer), video_wait_s
     (how long the rest waited for a preview rendering in its own process), report_s.
     The preview renders in the process ``preflight`` started, while the USD, OBJ and plots
-    are written here.
+    are written here. run_id: the run's id (a new one by default); request: what was asked
+    for, kept in the manifest; locked: the caller holds out_dir's runfolder.Lock.
     """
+    from contextlib import nullcontext
+
+    from . import runfolder
+    final = ensure_writable(out_dir)
+    run_id = run_id or runfolder.new_run_id()
+    with nullcontext() if locked else runfolder.Lock(final):
+        if not locked:
+            runfolder.claim(final)
+        staging = final / f".staging-{run_id}"
+        staging.mkdir(exist_ok=True)
+        paths = _write_all(result, staging, options, summary, run_id)
+        runfolder.publish(final, staging, run_id, request)
+    return [final / p.relative_to(staging) for p in paths]
+
+
+def _write_all(result, out, options, summary, run_id) -> list[Path]:
     from .rundata import from_result, write_scene_file
-    out = ensure_writable(out_dir)
-    summary = summary if summary is not None else result.summary()
+    summary = dict(summary if summary is not None else result.summary(), run_id=run_id)
     run = from_result(result)
     tm = options.timings
     t0 = time.perf_counter()
-    paths = list(result.save(out, summary))
+    paths = list(result.save(out, summary, run_id))
     files = {"summary (JSON)": paths[0], "tracks (NumPy npz)": paths[1]}
-    paths.append(write_scene_file(run, out))
+    paths.append(write_scene_file(run, out, run_id))
     tm["save_s"] = time.perf_counter() - t0
     files["shapes for the viewer"] = paths[-1]
     video = st = None

@@ -18,14 +18,19 @@ from ..systems.colliders import set_pieces
 from ..systems.rigid import Sphere, SphereParams
 from ..systems.static import StaticPlane
 from .contract import SceneSpec
+from ..params import param
 
 
 @dataclass(frozen=True)
 class BallParams(SphereParams):
     """The ball: a regulation basketball, hollow shell. position m, velocity m/s, spin rad/s."""
-    position: tuple = (0.02, 0.0, 3.65)
-    velocity: tuple = (0.3, 0.0, -1.0)
-    spin: tuple = (0.0, 0.0, 0.0)
+    position: tuple = param((0.02, 0.0, 3.65), "m", ge=-100.0, le=100.0,
+                           doc="centre at t = 0 (x, y, z)")
+    # 100 m/s moves the ball 1 mm per net step of 1e-5 s: faster tunnels through the cords
+    velocity: tuple = param((0.3, 0.0, -1.0), "m/s", ge=-100.0, le=100.0,
+                           doc="velocity at t = 0")
+    spin: tuple = param((0.0, 0.0, 0.0), "rad/s", ge=-1000.0, le=1000.0,
+                       doc="angular velocity at t = 0")
 
 
 @dataclass(frozen=True)
@@ -38,15 +43,16 @@ class BasketballParams:
     floor: ContactParams = ContactParams(stiffness=1.0e5, damping=40.0, friction=0.6,
                                          eps=0.05, thickness=0.0)
     field: DampingFieldParams = DampingFieldParams()
-    settle: bool = True  # let the net sag to rest under gravity before t = 0
+    settle: bool = param(True, doc="let the net sag to rest under gravity before t = 0")
     # s: forces are exchanged every coupling_dt; the net sub-cycles the ball contact inside it.
     # Set it to the net's dt for strict lock step (the reference).
-    coupling_dt: float = 1e-3
+    coupling_dt: float = param(1e-3, "s", ge=1e-7, le=0.1, doc="force exchange step")
     # "cords": the specialised sphere-cord contact (sub-cycled in the net's kernel); "mesh":
     # the general MeshContact between the ball's icosphere (mesh_subdivisions) and the cords as
     # segments, exchanged every net step (lock step: it is not sub-cycled), docs/collision.md
-    contact_model: str = "cords"
-    mesh_subdivisions: int = 3
+    contact_model: str = param("cords", choices=("cords", "mesh"), doc="ball-net contact")
+    mesh_subdivisions: int = param(3, "-", ge=0, le=6,
+                                   doc="icosphere subdivisions of the ball (3: 642 vertices)")
 
 
 FIT_TIME = 0.6  # s: the ball has left the net and not yet reached the floor

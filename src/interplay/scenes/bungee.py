@@ -7,8 +7,8 @@ The leap: stand, crouch, tip forward over the toes (ankles dorsiflex with balanc
 the centre of mass is far enough ahead, then a timed hip-knee-ankle extension with an arm
 swing, a tuck so the feet clear the edge, and a layout (swan dive) for the rest. The defaults
 of ``JumperParams`` were found by ``tune_leap`` (simulated annealing over the leap's parameters
-with the cord disabled; ``python -m interplay.scenes.bungee``), rounded and checked again;
-docs/figures.md has the search and its result.
+with the cord disabled; ``interplay tune bungee`` runs it on every core), rounded and checked
+again; docs/figures.md has the search and its result.
 """
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..control import behaviours as B
+from ..control.search import Search
 from ..control.fsm import Controller, State, Transition
 from ..geometry.anthropometry import SEGMENTS, BodyParams
 from ..geometry.setpieces import bridge
@@ -29,6 +30,7 @@ from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
 from ..systems.static import StaticPlane
 from .contract import SceneSpec
+from ..params import param
 
 BRIDGE = 40.0  # m, the platform's top
 EDGE = 0.0  # m, x of the platform's front edge (the jumper faces +x)
@@ -53,14 +55,15 @@ class CordParams:
     frequency, where an elastic pendulum pumps its bounce into a growing swing; 250 N/m keeps
     the 64 kg jumper well clear of it (k L0 / m g = 5.9). Damping 0.05 s gives the bounce a
     damping ratio of about 0.05 (k beta / 2 sqrt(k m)), a rubber cord's hysteresis."""
-    enabled: bool = True
-    length: float = 15.0  # m
-    stiffness: float = 250.0  # N/m, whole cord: its n-1 springs in series
-    mass: float = 1.0  # kg
-    points: int = 21
-    damping: float = 0.05  # s
-    dt: float = 1e-3  # s
-    reach: float = 1.8  # m
+    enabled: bool = param(True, doc="false: the jumper alone (leap tuning)")
+    length: float = param(15.0, "m", ge=0.1, le=1000.0, doc="rest length")
+    # whole cord: its n-1 springs in series
+    stiffness: float = param(250.0, "N/m", ge=1e-3, le=1e7, doc="the whole cord's")
+    mass: float = param(1.0, "kg", ge=1e-3, le=1000.0)
+    points: int = param(21, "points", ge=3, le=10_000, cost="points")
+    damping: float = param(0.05, "s", ge=0.0, le=10.0, doc="stiffness-proportional")
+    dt: float = param(1e-3, "s", ge=1e-9, le=0.1)
+    reach: float = param(1.8, "m", ge=0.0, le=100.0, doc="anchor past the deck's edge")
 
 
 @dataclass(frozen=True)
@@ -72,18 +75,18 @@ class JumperParams:
     hip (rad of hip flexion it extends to: a forward dive), power (-, scales the extension's
     velocity targets), arm_swing (rad of shoulder flexion the arms swing to); tuck (s) the knees
     are pulled up after takeoff so the feet clear the edge, before the layout."""
-    mass: float = 64.38  # kg
-    height: float = 1.70  # m
-    stand: float = 0.3  # s
-    crouch: float = 0.7  # s
-    depth: float = 0.65
-    lean: float = 0.36  # rad
-    lead: float = 0.16  # m
-    tip_ankle: float = 0.52  # rad
-    hip: float = 0.67  # rad
-    power: float = 1.24
-    arm_swing: float = 1.00  # rad
-    tuck: float = 0.75  # s
+    mass: float = param(64.38, "kg", ge=10.0, le=500.0)
+    height: float = param(1.70, "m", ge=0.5, le=3.0)
+    stand: float = param(0.3, "s", ge=0.0, le=100.0)
+    crouch: float = param(0.7, "s", ge=0.0, le=100.0)
+    depth: float = param(0.65, "-", ge=0.0, le=2.0, doc="crouch depth, 1 = deep")
+    lean: float = param(0.36, "rad", ge=-1.6, le=1.6, doc="trunk lean in the crouch")
+    lead: float = param(0.16, "m", ge=-1.0, le=1.0, doc="centre of mass ahead of the feet")
+    tip_ankle: float = param(0.52, "rad", ge=-1.6, le=1.6, doc="ankle dorsiflexion to tip")
+    hip: float = param(0.67, "rad", ge=-1.6, le=2.6, doc="hip flexion of the push")
+    power: float = param(1.24, "-", ge=0.0, le=5.0, doc="scales the extension's velocities")
+    arm_swing: float = param(1.00, "rad", ge=-3.2, le=3.2, doc="shoulder flexion of the swing")
+    tuck: float = param(0.75, "s", ge=0.0, le=100.0, doc="knees pulled up after takeoff")
 
 
 @dataclass(frozen=True)
@@ -92,8 +95,8 @@ class BungeeParams:
     jumper: JumperParams = JumperParams()
     cord: CordParams = CordParams()
     tie: AttachmentParams = AttachmentParams()
-    coupling_dt: float = 1e-3  # s
-    air_density: float = 1.2  # kg/m^3
+    coupling_dt: float = param(1e-3, "s", ge=1e-7, le=0.1)
+    air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0, doc="0: no drag")
 
 
 def controller(p: JumperParams) -> Controller:
@@ -215,26 +218,30 @@ BOUNDS = {"depth": (0.3, 1.1), "lean": (0.0, 0.8), "lead": (0.0, 0.3), "hip": (-
 
 
 def tune_leap(evaluations: int = 150, seed: int = 0, start: JumperParams = JumperParams()):
-    """Simulated annealing over the leap parameters in TUNED (cord disabled); returns the best
-    JumperParams and the SearchResult."""
+    """Simulated annealing over the leap parameters in TUNED (cord disabled), one candidate at
+    a time in this process; returns the best JumperParams and the SearchResult. ``interplay
+    tune bungee --chains 1`` runs the same search (on the executor)."""
     from ..control.search import anneal
     res = anneal(lambda d: leap_loss(replace(start, **d)),
                  {k: getattr(start, k) for k in TUNED}, BOUNDS, evaluations, seed)
     return replace(start, **res.best), res
 
 
+def leap_search_loss(coupling: str, kw: dict) -> float:
+    """The leap's loss for ``interplay tune bungee``: the jumper's parameters in the build
+    keywords kw; the cord and the coupling play no part (the figure leaps alone)."""
+    return leap_loss(kw["params"].jumper)
+
+
+LEAP_SEARCH = Search("leap", "the leap off the deck (figure alone): clear the edge, rise, "
+                     "never touch the deck after takeoff",
+                     bounds={f"jumper.{k}": v for k, v in BOUNDS.items()},
+                     loss=leap_search_loss, budget=150, chains=4)
+
 SPEC = SceneSpec(
     "bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)", build,
     BungeeParams, couplings=("two-way", "one-way"), duration=8.0, fps=30.0,
-    integrators=("explicit", "implicit", "localglobal"),
+    integrators=("explicit", "implicit", "localglobal"), searches=(LEAP_SEARCH,),
     # beside him and a little above, 6.7 m off: he stays a third of the frame tall all the way
     camera=TrackingCamera("jumper", offset=(5.2, -4.0, 1.2), target_offset=(0.4, 0.0, -0.3),
                           fov_deg=38.0, smooth_s=0.35), key_time=3.4)
-
-
-if __name__ == "__main__":
-    import sys
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 150
-    best, res = tune_leap(n)
-    print(f"loss {res.loss:.4f} after {n} evaluations; {leap_trial(best)}")
-    print(", ".join(f"{k}={getattr(best, k):.3f}" for k in TUNED))

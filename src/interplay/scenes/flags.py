@@ -16,6 +16,7 @@ from ..systems.springmass import SpringNetwork
 from ..systems.static import StaticPlane
 from ..systems.wind import FlowPrimitive, WindField
 from .contract import SceneSpec
+from ..params import param
 
 
 @dataclass(frozen=True)
@@ -26,21 +27,22 @@ class FlagParams:
     stiffness_damping (s): Rayleigh; dt (s) and integrator of its own simulation; cg_tolerance:
     the implicit solve's relative residual (1e-5 moves a point ~1e-5 of its step's change:
     invisible, and it halves the CG iterations of 1e-8)."""
-    pole: tuple = (0.0, 0.0, 0.0)
-    pole_height: float = 3.0
-    width: float = 1.5
-    height: float = 1.0
-    nu: int = 30
-    nv: int = 20
-    density: float = 0.15  # kg/m^2: cotton bunting
-    stretch: float = 150.0  # N: ~3000 N/m membrane stiffness at this spacing, cotton-like
-    shear: float = 50.0
-    bend: float = 0.5
-    mass_damping: float = 0.05
-    stiffness_damping: float = 2e-4
-    dt: float = 1.0 / 240.0
-    integrator: str = "implicit"
-    cg_tolerance: float = 1e-5
+    pole: tuple = param((0.0, 0.0, 0.0), "m", ge=-100.0, le=100.0, doc="foot of the pole")
+    pole_height: float = param(3.0, "m", ge=0.01, le=100.0, doc="the flag's top edge")
+    width: float = param(1.5, "m", ge=0.01, le=50.0)
+    height: float = param(1.0, "m", ge=0.01, le=50.0)
+    nu: int = param(30, "vertices", ge=2, le=2000, cost="points", doc="along the flag")
+    nv: int = param(20, "vertices", ge=2, le=2000, cost="points", doc="down the flag")
+    density: float = param(0.15, "kg/m^2", ge=1e-4, le=100.0)  # cotton bunting
+    # ~3000 N/m membrane stiffness at this spacing, cotton-like
+    stretch: float = param(150.0, "N", ge=1e-6, le=1e9, doc="stress/strain ratio")
+    shear: float = param(50.0, "N", ge=1e-6, le=1e9)
+    bend: float = param(0.5, "N", ge=1e-6, le=1e9)
+    mass_damping: float = param(0.05, "1/s", ge=0.0, le=1e4)
+    stiffness_damping: float = param(2e-4, "s", ge=0.0, le=1.0)
+    dt: float = param(1.0 / 240.0, "s", ge=1e-9, le=0.1)
+    integrator: str = param("implicit", choices=("explicit", "implicit", "localglobal"))
+    cg_tolerance: float = param(1e-5, "-", ge=1e-14, le=0.1, doc="implicit solve's residual")
 
 
 @dataclass(frozen=True)
@@ -48,11 +50,11 @@ class GustyWind:
     """speed (m/s) towards heading (deg from +x, counter-clockwise), gusting by +-gust of it
     with main period gust_period (s); cross (m/s): a sideways component gusting out of phase
     from 0 to 2 cross, so the wind's direction swings too."""
-    speed: float = 6.0
-    heading: float = 0.0
-    gust: float = 0.4
-    gust_period: float = 2.5
-    cross: float = 1.0
+    speed: float = param(6.0, "m/s", ge=0.0, le=100.0)
+    heading: float = param(0.0, "deg", ge=-360.0, le=360.0)
+    gust: float = param(0.4, "-", ge=0.0, le=1.0, doc="share of the speed")
+    gust_period: float = param(2.5, "s", ge=0.01, le=1000.0)
+    cross: float = param(1.0, "m/s", ge=-100.0, le=100.0)
 
 
 @dataclass(frozen=True)

@@ -19,6 +19,7 @@ from ..systems.springmass import SpringNetwork
 from ..systems.static import StaticPlane
 from ..systems.wind import FlowPrimitive, WindField
 from .contract import SceneSpec
+from ..params import intervals, param
 
 
 @dataclass(frozen=True)
@@ -28,24 +29,26 @@ class LeafParams:
     leaf mesh (``shapes.leaf``); density (kg/m^2); stretch, shear, bend (N): stress/strain
     ratios; vein: stiffness factor of the midrib; mass_damping (1/s), stiffness_damping (s);
     dt (s), integrator, cg_tolerance of the leaves' simulation (one network for all)."""
-    count: int = 36
-    area: tuple = (-1.5, 1.5, -1.0, 1.0)
-    seed: int = 7
-    length: float = 0.10
-    width: float = 0.05
-    spread: float = 0.3
-    stations: int = 6
-    rows: int = 2
-    density: float = 0.12  # kg/m^2: a dry autumn leaf
-    stretch: float = 5.0
-    shear: float = 3.0
-    bend: float = 0.5
-    vein: float = 5.0
-    mass_damping: float = 0.2
-    stiffness_damping: float = 1e-4
-    dt: float = 1.0 / 240.0
-    integrator: str = "implicit"
-    cg_tolerance: float = 1e-5
+    count: int = param(36, "leaves", ge=1, le=100_000, cost="points")
+    area: tuple = param((-1.5, 1.5, -1.0, 1.0), "m", ge=-100.0, le=100.0,
+                        check=intervals, doc="x0, x1, y0, y1 of the ground")
+    seed: int = param(7, "-", ge=0, le=2 ** 32 - 1)
+    length: float = param(0.10, "m", ge=0.005, le=2.0)
+    width: float = param(0.05, "m", ge=0.005, le=2.0)
+    spread: float = param(0.3, "-", ge=0.0, le=0.9, doc="sizes vary by 1 +- spread")
+    # a leaf has about (2 rows + 1) x stations points
+    stations: int = param(6, "-", ge=2, le=100, cost="points")
+    rows: int = param(2, "-", ge=1, le=50, cost="points")
+    density: float = param(0.12, "kg/m^2", ge=1e-4, le=100.0)  # a dry autumn leaf
+    stretch: float = param(5.0, "N", ge=1e-6, le=1e9)
+    shear: float = param(3.0, "N", ge=1e-6, le=1e9)
+    bend: float = param(0.5, "N", ge=1e-6, le=1e9)
+    vein: float = param(5.0, "-", ge=1e-3, le=1e4, doc="midrib stiffness factor")
+    mass_damping: float = param(0.2, "1/s", ge=0.0, le=1e4)
+    stiffness_damping: float = param(1e-4, "s", ge=0.0, le=1.0)
+    dt: float = param(1.0 / 240.0, "s", ge=1e-9, le=0.1)
+    integrator: str = param("implicit", choices=("explicit", "implicit", "localglobal"))
+    cg_tolerance: float = param(1e-5, "-", ge=1e-14, le=0.1)
 
 
 @dataclass(frozen=True)
@@ -55,17 +58,18 @@ class RiderParams:
     low pressure behind the rider, a sink of `sink` (m^3/s) at (-behind, 0, height) m that
     draws the leaves up after it, and a swirl about a vertical axis there (`swirl`, m^2/s),
     both with core radius `core` (m) and gusting by `gust` (a turbulent wake)."""
-    speed: float = 5.5
-    pass_time: float = 1.0
-    start: float = -8.0
-    end: float = 12.0
-    behind: float = 0.8
-    height: float = 0.7
-    sink: float = 40.0
-    swirl: float = 3.0
-    core: float = 0.4
-    gust: float = 0.3
-    mass: float = 85.0  # kg, rider and bicycle: what the logged wake force is divided by
+    speed: float = param(5.5, "m/s", ge=0.01, le=100.0)
+    pass_time: float = param(1.0, "s", ge=-1e4, le=1e4)
+    start: float = param(-8.0, "m", ge=-1e4, le=-0.01, doc="x where the ride starts")
+    end: float = param(12.0, "m", ge=0.01, le=1e4, doc="x where the ride ends")
+    behind: float = param(0.8, "m", ge=-100.0, le=100.0)
+    height: float = param(0.7, "m", ge=-100.0, le=100.0)
+    sink: float = param(40.0, "m^3/s", ge=-1e4, le=1e4)
+    swirl: float = param(3.0, "m^2/s", ge=-1e4, le=1e4)
+    core: float = param(0.4, "m", ge=1e-3, le=100.0)
+    gust: float = param(0.3, "-", ge=0.0, le=1.0)
+    # rider and bicycle: what the logged wake force is divided by
+    mass: float = param(85.0, "kg", ge=1e-3, le=1e4)
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ resolved). Without the clip the foot follows the keyframed running step of FootP
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -18,12 +18,12 @@ from ..geometry.anthropometry import SEGMENTS
 from ..geometry.basin import BasinParams, banks, basin, terrain
 from ..interactions.buoyancy import BodyInWater, BuoyancyParams
 from ..interactions.standins import ViscousDragField, ViscousDragFieldParams
-from ..params import ANY_LENGTH
 from ..outputs.render.camera import TrackingCamera
+from ..params import param
 from ..scene import Scene
 from ..systems.colliders import set_pieces
 from ..systems.kinematic import KeyframedBody, KeyframedBodyParams
-from ..systems.mocap import MocapFigure, clip_path
+from ..systems.mocap import MocapFigure, check_clip, clip_path
 from ..systems.water import SprayParams, Water, WaterParams
 from .contract import SceneSpec
 
@@ -33,16 +33,19 @@ class FootParams(KeyframedBodyParams):
     """A running step: the foot swings in at about 2 m/s down and forward, lands flat on the
     bed (centre one semi-axis above it), rolls forward 3 cm in 0.2 s of stance and pushes off.
     times in s, positions m (x, y, z per key)."""
-    times: tuple = field(default=(0.0, 0.12, 0.2, 0.4, 0.52, 0.75), metadata=ANY_LENGTH)
-    positions: tuple = field(default=(-0.55, 0.0, 0.28,
-                                      -0.2, 0.0, 0.15,
-                                      -0.06, 0.0, 0.045,
-                                      -0.03, 0.0, 0.045,
-                                      0.12, 0.0, 0.14,
-                                      0.55, 0.0, 0.3), metadata=ANY_LENGTH)
-    semi_axes: tuple = (0.13, 0.05, 0.045)  # m: a shoe 26 cm long, 10 cm wide
-    mass: float = 1.2  # kg: foot and shank
-    dt: float = 0.002  # s
+    times: tuple = param((0.0, 0.12, 0.2, 0.4, 0.52, 0.75), "s", ge=0.0, le=1e5, length=None,
+                         doc="key times, increasing")
+    positions: tuple = param((-0.55, 0.0, 0.28,
+                              -0.2, 0.0, 0.15,
+                              -0.06, 0.0, 0.045,
+                              -0.03, 0.0, 0.045,
+                              0.12, 0.0, 0.14,
+                              0.55, 0.0, 0.3), "m", ge=-1e4, le=1e4, length=None,
+                             doc="x, y, z of each key")
+    # a shoe 26 cm long, 10 cm wide
+    semi_axes: tuple = param((0.13, 0.05, 0.045), "m", ge=1e-3, le=10.0)
+    mass: float = param(1.2, "kg", ge=1e-3, le=1e4, doc="foot and shank")
+    dt: float = param(0.002, "s", ge=1e-9, le=1.0)
 
 
 @dataclass(frozen=True)
@@ -56,8 +59,10 @@ class PuddleParams:
     foot: FootParams = FootParams()
     buoyancy: BuoyancyParams = BuoyancyParams()
     field: ViscousDragFieldParams = ViscousDragFieldParams(linear=2.0, quadratic=20.0)
-    coupling_dt: float = 2e-3  # s
-    clip: str = "cmu_02_03_run.bvh"  # the runner; "" (or no data folder): the keyframed foot
+    coupling_dt: float = param(2e-3, "s", ge=1e-7, le=0.1)
+    # the runner; "": the keyframed foot
+    clip: str = param("cmu_02_03_run.bvh", check=check_clip,
+                      doc="a BVH clip in the mocap folder or a path; empty: keyframes")
 
 
 PAVEMENT = (0.30, 0.30, 0.31)  # linear RGB

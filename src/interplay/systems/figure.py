@@ -20,6 +20,7 @@ from ..control.fsm import Controller, StateMachine
 from ..control.gravity import GravityCompensation
 from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
+from ..params import param
 from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, joint_names,
                                       segment_mesh, segment_primitive)
 from .base import System, substeps
@@ -48,13 +49,13 @@ class FigureParams:
     gravity (control/gravity.py) to the servo law."""
     body: BodyParams = BodyParams()
     environment: EnvironmentParams = EnvironmentParams()
-    position: tuple = (0.0, 0.0, 0.0)  # m
-    yaw: float = 0.0  # rad
-    dt: float = 1e-3  # s
-    control_dt: float = 5e-3  # s
-    omega: float = 20.0  # rad/s
-    zeta: float = 1.0
-    support_omega: float = 8.0  # rad/s
+    position: tuple = param((0.0, 0.0, 0.0), "m", ge=-1e4, le=1e4)
+    yaw: float = param(0.0, "rad", ge=-100.0, le=100.0)
+    dt: float = param(1e-3, "s", ge=1e-7, le=0.01)
+    control_dt: float = param(5e-3, "s", ge=1e-5, le=0.1)
+    omega: float = param(20.0, "rad/s", gt=0.0, le=1e3)
+    zeta: float = param(1.0, "-", gt=0.0, le=10.0)
+    support_omega: float = param(8.0, "rad/s", gt=0.0, le=1e3)
     gravity_compensation: bool = True
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, segment_mesh,
                                       segment_primitive)
-from ..io.motion_file import BVHError, Motion, read_bvh
+from ..io.motion_file import BVHError, Motion, check_file, read_bvh
 from ..kernels.rigid import quat_mul
 from .base import Role, System
 from .shape import figure_shape
@@ -353,11 +353,34 @@ class MocapFigure(System, RigidParts):
 
 
 def clip_path(name: str) -> Path:
-    """A clip in the shared mocap data folder: shared/data/mocap beside the repository or
-    beside any folder above it (a worktree's repository sits deeper)."""
+    """A clip in the mocap data folder: $INTERPLAY_MOCAP_DIR if set, else shared/data/mocap
+    beside the repository or beside any folder above it (a worktree's repository sits
+    deeper); or ``name`` itself when it is a path."""
+    import os
+    if os.environ.get("INTERPLAY_MOCAP_DIR"):
+        return Path(os.environ["INTERPLAY_MOCAP_DIR"]) / name
     repo = Path(__file__).resolve().parents[3]
     for base in (repo, *repo.parents):
         folder = base / "shared" / "data" / "mocap"
         if folder.is_dir():
             return folder / name
     return repo.parent / "shared" / "data" / "mocap" / name
+
+
+def check_clip(name: str) -> None:
+    """A parameter check: "" (no clip) or a readable BVH clip (a name in the mocap folder or a
+    path to a regular file, bounded in size: io.motion_file.check_file). ParameterError
+    naming the clips there otherwise, so a mistyped name is not a silent fallback."""
+    if not name:
+        return
+    path = clip_path(name)
+    if not path.exists():
+        folder = clip_path("")
+        have = sorted(p.name for p in folder.glob("*.bvh")) if folder.is_dir() else []
+        raise ParameterError(f"no clip {name!r}" + (
+            f"; clips in {folder.resolve()}: {', '.join(have)}" if have else
+            f" and no mocap folder at {folder.resolve()}") + "; or '' for the keyframed foot")
+    try:
+        check_file(path)
+    except BVHError as e:
+        raise ParameterError(str(e)) from None

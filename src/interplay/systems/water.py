@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
 from ..kernels import lids as L
+from ..params import param, zero_or_at_least
 from ..kernels import water as K
 from .base import System
 from .shape import Shape
@@ -40,12 +41,12 @@ class SprayParams:
     capacity: most particles airborne at once (output frames are padded to it); drag: drag
     coefficient (-) of a droplet in air of density air_density (kg/m^3)."""
     enabled: bool = True
-    threshold: float = 0.6  # m/s
-    fraction: float = 0.3
-    radius: float = 0.004  # m
-    capacity: int = 4096
-    drag: float = 0.47
-    air_density: float = 1.2  # kg/m^3
+    threshold: float = param(0.6, "m/s", ge=1e-6, le=100.0)
+    fraction: float = param(0.3, "-", ge=0.0, le=1.0)
+    radius: float = param(0.004, "m", ge=1e-5, le=0.1)
+    capacity: int = param(4096, "particles", ge=1, le=10_000_000, cost="particles")
+    drag: float = param(0.47, "-", ge=0.0, le=10.0)
+    air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
 
 
 @dataclass(frozen=True)
@@ -58,14 +59,16 @@ class WaterParams:
     body touches the water the substeps shrink by sqrt(1 + kappa). body_samples: sample points
     per column side where a body cuts the columns. body_damping (1/s): extra pipe friction
     under a body (its wetted surface), which damps waves trapped under it."""
-    density: float = 1000.0  # kg/m^3
-    gravity: float = 9.81  # m/s^2
-    damping: float = 0.5  # 1/s
-    cfl: float = 0.5
-    dt: float = 0.0  # s, 0 = automatic
-    body_stiffness: float = 30.0
-    body_samples: int = 4
-    body_damping: float = 200.0  # 1/s
+    density: float = param(1000.0, "kg/m^3", ge=1.0, le=1e5)
+    gravity: float = param(9.81, "m/s^2", ge=0.01, le=100.0)
+    damping: float = param(0.5, "1/s", ge=0.0, le=1e4)
+    cfl: float = param(0.5, "-", ge=0.01, le=0.7)
+    dt: float = param(0.0, "s", ge=0.0, le=0.1, check=zero_or_at_least(1e-9),
+                      doc="0: automatic")
+    # the substeps shrink by sqrt(1 + kappa) under a body: 1e4 is 100x the steps
+    body_stiffness: float = param(30.0, "-", ge=1e-6, le=1e4)
+    body_samples: int = param(4, "-", ge=1, le=16)
+    body_damping: float = param(200.0, "1/s", ge=0.0, le=1e5)
     spray: SprayParams = SprayParams()
 
 
