@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_positive
+from ..params import param
 
 MANOEUVRES = ("hold", "loop", "figure8")
 
@@ -48,19 +49,19 @@ class StuntPilotParams:
     long before the nose completes its circle at the present rate of turn (the arms and the
     kite lag the hands); rate (Hz): how often the pilot looks
     and acts."""
-    manoeuvre: str = "loop"
-    start: float = 8.0
-    every: float = 12.0
-    ready: float = 40.0
-    target: float = 0.0
-    gain: float = 2.0
-    hold_tilt: float = 30.0
-    turn_gain: float = 0.8
-    turn_damping: float = 0.3
-    throw: float = 0.25
-    brace: float = 0.0
-    lead: float = 0.2
-    rate: float = 20.0
+    manoeuvre: str = param("loop", "-", choices=MANOEUVRES)
+    start: float = param(8.0, "s", ge=0.0, le=1e5)
+    every: float = param(12.0, "s", gt=0.0, le=1e5)
+    ready: float = param(40.0, "deg", ge=0.0, le=90.0)
+    target: float = param(0.0, "deg", ge=-90.0, le=90.0)
+    gain: float = param(2.0, "-", ge=0.0, le=100.0)
+    hold_tilt: float = param(30.0, "deg", ge=0.0, le=90.0)
+    turn_gain: float = param(0.8, "1/rad", ge=0.0, le=100.0)
+    turn_damping: float = param(0.3, "s/rad", ge=0.0, le=100.0)
+    throw: float = param(0.25, "m", ge=0.0, le=1.0)
+    brace: float = param(0.0, "m", ge=-1.0, le=1.0)
+    lead: float = param(0.2, "s", ge=0.0, le=5.0)
+    rate: float = param(20.0, "Hz", gt=0.0, le=1000.0)
 
 
 def window_coordinates(position, centre):

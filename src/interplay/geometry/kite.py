@@ -9,9 +9,6 @@ from it in ``scenes/kite_parts.py``).
 Designs (traditional proportions, e.g. Pelham, *The Penguin Book of Kites*, 1976):
 * ``DiamondParams``: the flat two-stick kite: a spine and a cross spar a quarter of the way
   down it, the sail tied along both; a two-leg bridle from the spine; flown with a tail.
-* ``DeltaParams``: a delta wing: a spine, two leading-edge spars swept back from the nose with
-  a little dihedral (the wings bent back out of the spine's plane) and a spreader behind the
-  sail; the sail is tied along the spine and the leading edges, its trailing edge is free.
 * ``RokkakuParams``: the Japanese six-sided kite: a spine and two cross spars near its ends,
   bowed back; a hexagonal sail tied along all three.
 * ``StuntParams``: a two-line stunt delta with two bridles, one per flying line.
@@ -24,14 +21,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError, require_positive
+from ..params import param
 
 
 @dataclass(frozen=True)
 class SparParams:
     """The frame's spars: radius (m) and density (kg/m^3) of a solid rod (a wooden dowel:
     ~600-700; a carbon rod: ~1600); the frame is a rigid body of their masses."""
-    radius: float = 0.003
-    density: float = 650.0
+    radius: float = param(0.003, "m", gt=0.0, le=0.1)
+    density: float = param(650.0, "kg/m^3", gt=0.0, le=20000.0)
 
 
 @dataclass(frozen=True)
@@ -42,38 +40,14 @@ class DiamondParams:
     towing point, tow (fraction from the nose, projected on the spine) and tow_height (m) in
     front of the sail; dihedral (deg): the cross spar bowed back so that each wingtip is
     this far out of the spine's plane; the tail hangs from the spine's foot."""
-    length: float = 1.0
-    span: float = 0.85
-    cross: float = 0.25
-    dihedral: float = 0.0
-    bridle: tuple = (0.04, 0.78)
-    tow: float = 0.36
-    tow_height: float = 0.32
+    length: float = param(1.0, "m", gt=0.0, le=20.0)
+    span: float = param(0.85, "m", gt=0.0, le=20.0)
+    cross: float = param(0.25, "-", ge=0.0, le=1.0)
+    dihedral: float = param(0.0, "deg", ge=0.0, lt=45.0)
+    bridle: tuple = param((0.04, 0.78), "-", ge=0.0, le=1.0, length=2)
+    tow: float = param(0.36, "-", ge=0.0, le=1.0)
+    tow_height: float = param(0.32, "m", gt=0.0, le=20.0)
     spars: SparParams = SparParams()
-
-
-@dataclass(frozen=True)
-class DeltaParams:
-    """A delta. span (m) between the wingtips; length (m) of the spine; sweep (m): how far
-    back from the nose (along the spine) the wingtips are; dihedral (deg): each leading edge
-    bent back out of the spine's plane; spreader (fraction of each leading edge from the
-    nose): where the spreader spar joins them; bridle (fractions of the spine from the nose)
-    where the legs start, meeting at tow (fraction) and tow_height (m) in front of the sail;
-    keel (m): the height of a triangular keel sewn along the spine between keel_span
-    (fractions from the nose), standing out in front of the sail (0: none): the fin that
-    keeps a delta's nose into the wind; ballast (kg): a weight at the spine's foot."""
-    span: float = 1.6
-    length: float = 0.8
-    sweep: float = 0.6
-    dihedral: float = 10.0
-    spreader: float = 0.55
-    bridle: tuple = (0.12, 0.82)
-    tow: float = 0.42
-    tow_height: float = 0.45
-    keel: float = 0.0
-    keel_span: tuple = (0.2, 0.75)
-    ballast: float = 0.0
-    spars: SparParams = SparParams(radius=0.003, density=900.0)
 
 
 @dataclass(frozen=True)
@@ -82,13 +56,13 @@ class RokkakuParams:
     spine at spars (fractions from the top); dihedral (deg): the cross spars bowed back so
     their tips are this far out of the spine's plane; bridle and tow, tow_height as the
     diamond's."""
-    length: float = 1.2
-    span: float = 0.95
-    spars: tuple = (0.2, 0.8)
-    dihedral: float = 12.0
-    bridle: tuple = (0.1, 0.85)
-    tow: float = 0.42
-    tow_height: float = 0.45
+    length: float = param(1.2, "m", gt=0.0, le=20.0)
+    span: float = param(0.95, "m", gt=0.0, le=20.0)
+    spars: tuple = param((0.2, 0.8), "-", ge=0.0, le=1.0, length=2)
+    dihedral: float = param(12.0, "deg", ge=0.0, lt=45.0)
+    bridle: tuple = param((0.1, 0.85), "-", ge=0.0, le=1.0, length=2)
+    tow: float = param(0.42, "-", ge=0.0, le=1.0)
+    tow_height: float = param(0.45, "m", gt=0.0, le=20.0)
     rods: SparParams = SparParams(radius=0.003, density=650.0)
 
 
@@ -105,17 +79,17 @@ class StuntParams:
     pulls its end out towards the towing point ahead of the frame's centre of mass and the
     other two pull theirs in behind it, so a pull on one line turns the kite's nose to that
     side as it rolls it (its force tilting to that side): pull left to turn left."""
-    span: float = 2.2
-    length: float = 0.85
-    sweep: float = 0.55
-    dihedral: float = 8.0
-    spreader: float = 0.45
-    lower: float = 0.7
-    bridle: tuple = (0.12, 0.78, 0.62)
-    tow: float = 0.44
-    tow_side: float = 0.22
-    tow_height: float = 0.6
-    ballast: float = 0.0
+    span: float = param(2.2, "m", gt=0.0, le=20.0)
+    length: float = param(0.85, "m", gt=0.0, le=20.0)
+    sweep: float = param(0.55, "m", gt=0.0, le=20.0)
+    dihedral: float = param(8.0, "deg", ge=0.0, lt=45.0)
+    spreader: float = param(0.45, "-", ge=0.0, le=1.0)
+    lower: float = param(0.7, "-", ge=0.0, le=1.0)
+    bridle: tuple = param((0.12, 0.78, 0.62), "-", ge=0.0, le=1.0, length=3)
+    tow: float = param(0.44, "-", ge=0.0, le=1.0)
+    tow_side: float = param(0.22, "m", gt=0.0, le=10.0)
+    tow_height: float = param(0.6, "m", gt=0.0, le=20.0)
+    ballast: float = param(0.0, "kg", ge=0.0, le=100.0)
     spars: SparParams = SparParams(radius=0.003, density=900.0)
 
 
@@ -209,31 +183,6 @@ def diamond(p: DiamondParams, n: int = 8) -> KiteGeometry:
     legs, towing = _bridle("diamond", nose, foot, p.bridle, p.tow, p.tow_height)
     return KiteGeometry(v, t, on_segments(v, spars), spars, p.spars.radius, p.spars.density,
                         [(legs, towing)], foot.copy())
-
-
-def delta(p: DeltaParams, n: int = 8) -> KiteGeometry:
-    """The delta: two sail triangles (nose, wingtip, spine's foot) meeting along the spine,
-    tied along the spine and the leading edges; the spreader joins the leading edges behind
-    the sail."""
-    S = require_positive("delta", "span", p.span, "m")
-    L = require_positive("delta", "length", p.length, "m")
-    sweep = require_positive("delta", "sweep", p.sweep, "m")
-    g = _dihedral("delta", p.dihedral)
-    nose, foot = np.zeros(3), np.array([-L, 0.0, 0.0])
-    half = S / 2
-    left = np.array([-sweep, half * math.cos(g), -half * math.sin(g)])
-    right = left * [1.0, -1.0, 1.0]
-    pieces = [(nose, left, foot), (nose, foot, right)]
-    if p.keel > 0.0:
-        k0, k1 = (_fraction("delta", "keel_span", f) * foot for f in p.keel_span)
-        pieces.append((k0, k1, 0.5 * (k0 + k1) + [0.0, 0.0, p.keel]))
-    v, t = subdivided(pieces, n)
-    s = _fraction("delta", "spreader", p.spreader)
-    spars = np.array([(nose, foot), (nose, left), (nose, right), (s * left, s * right)])
-    legs, towing = _bridle("delta", nose, foot, p.bridle, p.tow, p.tow_height)
-    ballast = ((foot.copy(), float(p.ballast)),) if p.ballast > 0 else ()
-    return KiteGeometry(v, t, on_segments(v, spars[:3]), spars, p.spars.radius,
-                        p.spars.density, [(legs, towing)], foot.copy(), ballast)
 
 
 def rokkaku(p: RokkakuParams, n: int = 5) -> KiteGeometry:

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative
-from ..params import param
 from ..kernels import aero as K
+from ..params import param
 from .base import Interaction
 
 
@@ -73,11 +73,11 @@ class CordDragParams:
     (~1.1-1.2 at a line's Reynolds numbers of 1e2-1e3, Hoerner, *Fluid-Dynamic Drag*, 1965,
     ch. 3); friction: C_f along it (skin friction on the wetted circumference); bow_drag: C_D
     of a bow (a crumpled ribbon: ~1); bow_area (m^2): the frontal area of each bow."""
-    density: float = 1.2
-    drag: float = 1.1
-    friction: float = 0.01
-    bow_drag: float = 1.0
-    bow_area: float = 0.0
+    density: float = param(1.2, "kg/m^3", ge=0.0, le=1500.0)
+    drag: float = param(1.1, "-", ge=0.0, le=10.0, doc="C_D across")
+    friction: float = param(0.01, "-", ge=0.0, le=1.0, doc="C_f along")
+    bow_drag: float = param(1.0, "-", ge=0.0, le=10.0)
+    bow_area: float = param(0.0, "m^2", ge=0.0, le=1.0)
 
 
 class CordDrag(Interaction):

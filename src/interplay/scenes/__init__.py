@@ -11,9 +11,10 @@ MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "pond", 
 
 
 def spec(name: str):
-    """The SceneSpec of the scene called ``name``; SceneError listing the known scenes."""
+    """The SceneSpec of the scene called ``name`` (or named by its module: stunt_kite for
+    stunt-kite); SceneError listing the known scenes."""
     for module in MODULES:
-        if module.replace("_", "-") == name:
+        if name in (module, module.replace("_", "-")):
             return importlib.import_module(f"{__name__}.{module}").SPEC
     raise SceneError(f"unknown scene {name!r}; known scenes: {', '.join(sorted(MODULES))}")
 

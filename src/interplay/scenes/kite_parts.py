@@ -34,6 +34,7 @@ from ..geometry.kite import KiteGeometry, frame_inertia, spar_mesh
 from ..interactions.aero import AeroParams, Aerodynamics, CordDrag, CordDragParams
 from ..interactions.attachment import AttachmentParams, SegmentAttachment
 from ..interactions.ground import GroundContact, GroundParams
+from ..params import param
 from ..systems.rigid import RigidBody
 from ..systems.springmass import SpringNetwork, Springs
 from ..systems.wind import FlowPrimitive, WindField
@@ -59,15 +60,15 @@ class KiteWind:
     main period gust_period (s); carrying turbulence of rms turbulence (share of speed, per
     component) in eddies of scale (m); seed picks the gusts' phase and the eddies (one wind
     per seed)."""
-    speed: float = 6.0
-    height: float = 10.0
-    roughness: float = 0.03
-    heading: float = 0.0
-    gust: float = 0.2
-    gust_period: float = 7.0
-    turbulence: float = 0.1
-    scale: float = 8.0
-    seed: int = 0
+    speed: float = param(6.0, "m/s", ge=0.0, le=40.0, doc="at the reference height")
+    height: float = param(10.0, "m", gt=0.0, le=200.0)
+    roughness: float = param(0.03, "m", gt=0.0, le=2.0, doc="roughness length")
+    heading: float = param(0.0, "deg", ge=-360.0, le=360.0)
+    gust: float = param(0.2, "-", ge=0.0, le=1.0)
+    gust_period: float = param(7.0, "s", gt=0.0, le=600.0)
+    turbulence: float = param(0.1, "-", ge=0.0, le=1.0, doc="rms per component, share of speed")
+    scale: float = param(8.0, "m", gt=0.0, le=1000.0)
+    seed: int = param(0, "-", ge=0, le=2 ** 31 - 1)
 
 
 def kite_wind(w: KiteWind) -> WindField:
@@ -93,15 +94,15 @@ class SailParams:
     than the frame (it billows); resolution: cuts per edge of each of the design's triangles;
     mass_damping (1/s), stiffness_damping (s); dt (s) of its implicit (BDF2) steps; ties: the
     springs holding it along the spars."""
-    density: float = 0.045
-    stretch: float = 300.0
-    shear: float = 80.0
-    bend: float = 0.5
-    slack: float = 0.01
-    resolution: int = 8
-    mass_damping: float = 0.05
-    stiffness_damping: float = 2e-4
-    dt: float = 1.0 / 240.0
+    density: float = param(0.045, "kg/m^2", gt=0.0, le=10.0)
+    stretch: float = param(300.0, "N", gt=0.0, le=1e7)
+    shear: float = param(80.0, "N", ge=0.0, le=1e7)
+    bend: float = param(0.5, "N", ge=0.0, le=1e6)
+    slack: float = param(0.01, "-", ge=0.0, lt=0.2)
+    resolution: int = param(8, "cuts", ge=1, le=40, cost=("points", 2))
+    mass_damping: float = param(0.05, "1/s", ge=0.0, le=100.0)
+    stiffness_damping: float = param(2e-4, "s", ge=0.0, le=1.0)
+    dt: float = param(1.0 / 240.0, "s", ge=1e-6, le=0.05)
     ties: AttachmentParams = AttachmentParams(stiffness=400.0, damping=0.5)
 
 
@@ -112,13 +113,13 @@ class LineParams:
     implicit solve short: 2 kN stretches 0.25% at 5 N), radius (m), stiffness_damping (s),
     dt (s); the bridle legs are the same cord; ties: the legs' ties to the frame and the
     line's to the flyer's hand."""
-    length: float = 25.0
-    segments: int = 25
-    density: float = 6e-4
-    stiffness: float = 2000.0
-    radius: float = 6e-4
-    stiffness_damping: float = 1e-3
-    dt: float = 1.0 / 240.0
+    length: float = param(25.0, "m", gt=0.0, le=1000.0)
+    segments: int = param(25, "segments", ge=2, le=2000, cost="points")
+    density: float = param(6e-4, "kg/m", gt=0.0, le=1.0)
+    stiffness: float = param(2000.0, "N", gt=0.0, le=1e7, doc="E A")
+    radius: float = param(6e-4, "m", gt=0.0, le=0.05)
+    stiffness_damping: float = param(1e-3, "s", ge=0.0, le=1.0)
+    dt: float = param(1.0 / 240.0, "s", ge=1e-6, le=0.05)
     ties: AttachmentParams = AttachmentParams(stiffness=250.0, damping=0.5)
 
 
@@ -127,15 +128,15 @@ class TailParams:
     """A string with bows: length (m), segments, bows (one every ``bow_every`` points from the
     end, 0: a bare string), bow_mass (kg), bow_area (m^2: its frontal area), string density
     (kg/m), radius (m), stiffness E A (N), dt (s); length 0: no tail."""
-    length: float = 4.0
-    segments: int = 16
-    bow_every: int = 2
-    bow_mass: float = 0.002
-    bow_area: float = 0.012
-    density: float = 1e-3
-    radius: float = 1e-3
-    stiffness: float = 500.0
-    dt: float = 1.0 / 240.0
+    length: float = param(4.0, "m", ge=0.0, le=100.0, doc="0: no tail")
+    segments: int = param(16, "segments", ge=1, le=2000, cost="points")
+    bow_every: int = param(2, "points", ge=0, le=1000, doc="0: a bare string")
+    bow_mass: float = param(0.002, "kg", ge=0.0, le=1.0)
+    bow_area: float = param(0.012, "m^2", ge=0.0, le=1.0)
+    density: float = param(1e-3, "kg/m", gt=0.0, le=1.0)
+    radius: float = param(1e-3, "m", gt=0.0, le=0.05)
+    stiffness: float = param(500.0, "N", gt=0.0, le=1e7, doc="E A")
+    dt: float = param(1.0 / 240.0, "s", ge=1e-6, le=0.05)
     tie: AttachmentParams = AttachmentParams(stiffness=300.0, damping=0.3)
 
 

@@ -13,13 +13,14 @@ side, and the tail's drag damps the pitch (docs/kites.md derives both).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..control.kite_pilot import StuntPilot, StuntPilotParams, window_coordinates
 from ..geometry.kite import SparParams, StuntParams, stunt
 from ..outputs.render.camera import Camera
+from ..params import param
 from ..scene import Scene
 from ..systems.pilot import Pilot, PilotParams
 from ..systems.static import StaticPlane
@@ -43,7 +44,7 @@ class StuntKiteParams:
     pilot: PilotParams = PilotParams()
     control: StuntPilotParams = StuntPilotParams()
     wind: KP.KiteWind = KP.KiteWind(speed=8.0, turbulence=0.05)
-    coupling_dt: float = 1.0 / 240.0
+    coupling_dt: float = param(1.0 / 240.0, "s", ge=1e-6, le=0.05)
 
 
 def build(coupling: str = "two-way", duration: float = 24.0, fps: float = 30.0,
@@ -90,7 +91,7 @@ def figures(result) -> dict:
     weight = result.meta.get("line_weight_n", 0.0)
     for part in ("l_handle", "r_handle"):
         log = result.logs.get(f"stunt-{part}")
-        if log is not None and len(log.t):
+        if log is not None and (log.t >= KP.LAUNCH).any():
             after = log.t >= KP.LAUNCH
             f = np.linalg.norm(log.force[after], axis=1)
             out[f"{part} taut share"] = round(float(np.mean(f > TAUT * weight)), 4)

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import ParameterError, require_positive
 from ..geometry.anthropometry import SEGMENTS, BodyParams, body_plan, segment_mesh
+from ..params import param
 from .base import Role, System
 from .shape import CLOTHES, Shape
 from .views import BodiesView, RigidParts
@@ -36,15 +37,15 @@ class PilotParams:
     forward, y half the spread between two handles, z height above the ground); reach (m):
     how far a handle may move from rest; response (s): the arms' time constant; lean (deg):
     the body leaning back against the pull; mass (kg) and height (m) of the person."""
-    position: tuple = (0.0, 0.0, 0.0)
-    heading: float = 0.0
-    handles: int = 2
-    grip: tuple = (0.35, 0.22, 1.05)
-    reach: float = 0.35
-    response: float = 0.08
-    lean: float = 6.0
-    mass: float = 75.0
-    height: float = 1.75
+    position: tuple = param((0.0, 0.0, 0.0), "m")
+    heading: float = param(0.0, "deg", ge=-360.0, le=360.0)
+    handles: int = param(2, "-", ge=1, le=2)
+    grip: tuple = param((0.35, 0.22, 1.05), "m", ge=-3.0, le=3.0)
+    reach: float = param(0.35, "m", gt=0.0, le=1.0)
+    response: float = param(0.08, "s", gt=0.0, le=10.0)
+    lean: float = param(6.0, "deg", ge=-45.0, le=45.0)
+    mass: float = param(75.0, "kg", ge=10.0, le=500.0)
+    height: float = param(1.75, "m", ge=0.5, le=3.0)
 
 
 def _rotation(axis, angle):
