@@ -139,5 +139,5 @@ SPEC = SceneSpec(
     "kites", "a diamond, an Eddy and a rokkaku on their lines in a gusty wind (two-way "
     "components)", build, KitesParams, couplings=("two-way",), duration=30.0, fps=30.0,
     # behind the flyers and to one side, looking up along the lines at the three kites
-    camera=Camera((-16.0, -24.0, 3.0), (12.0, 0.0, 13.0), 50.0), key_time=25.0,
+    camera=Camera((-13.0, -23.0, 2.2), (14.0, -1.0, 12.0), 50.0), key_time=25.0,
     figures=figures)

@@ -109,5 +109,5 @@ SPEC = SceneSpec(
     "stunt-kite", "a two-line stunt kite flown through loops by a pilot (two-way components)",
     build, StuntKiteParams, couplings=("two-way",), duration=24.0, fps=30.0,
     # behind the pilot, the wind window ahead: the kite loops 25 m downwind
-    camera=Camera((-7.0, -3.0, 2.0), (14.0, 1.0, 9.0), 52.0), key_time=10.0,
+    camera=Camera((-9.0, -3.5, 1.8), (14.0, 1.0, 8.5), 56.0), key_time=10.0,
     figures=figures)
