@@ -26,7 +26,25 @@ class AeroParams:
     friction: float = param(0.02, "kg/(m^2 s)", ge=0.0, le=100.0, doc="c_t")
 
 
-class Aerodynamics(Interaction):
+class _AirOn(Interaction):
+    """What the air's interactions share: one-way (the air does not feel the body), forces on
+    every point of the body's view with their velocity Jacobian for implicit bodies, the
+    reaction logged on the wind and never applied."""
+
+    def _buffers(self, n):
+        self._idx = np.arange(n)
+        self._f = np.zeros((n, 3))
+        self._dfdx = np.zeros((n, 3, 3))
+        self._dfdv = np.zeros((n, 3, 3))
+
+    def exchange(self, to_primary, to_secondary):
+        f, dfdv, total = self.forces(self.body.jacobians)
+        if to_secondary:
+            self.body.apply(self._idx, f, self._dfdx, dfdv)
+        return -total, np.zeros(3), True
+
+
+class Aerodynamics(_AirOn):
     """Drag and lift on every triangle of ``body`` from the ``wind`` at its centroid, sampled at
     the body's own time. For implicit bodies the force carries its velocity Jacobian, so a
     light leaf in a strong gust stays stable at large steps."""
@@ -41,10 +59,7 @@ class Aerodynamics(Interaction):
         self.cn = require_nonnegative(name, "drag", params.drag, "kg/m^3")
         self.ct = require_nonnegative(name, "friction", params.friction, "kg/(m^2 s)")
         n = len(self.body.x)
-        self._idx = np.arange(n)
-        self._f = np.zeros((n, 3))
-        self._dfdx = np.zeros((n, 3, 3))
-        self._dfdv = np.zeros((n, 3, 3))
+        self._buffers(n)
         self._cent = np.zeros((len(self.tris), 3))
 
     def forces(self, with_jacobian=False):
@@ -59,11 +74,6 @@ class Aerodynamics(Interaction):
                                   self._dfdv, with_jacobian)
         return self._f, self._dfdv, total
 
-    def exchange(self, to_primary, to_secondary):
-        f, dfdv, total = self.forces(self.body.jacobians)
-        if to_secondary:
-            self.body.apply(self._idx, f, self._dfdx, dfdv)
-        return -total, np.zeros(3), True
 
 
 @dataclass(frozen=True)
@@ -80,7 +90,7 @@ class CordDragParams:
     bow_area: float = param(0.0, "m^2", ge=0.0, le=1.0)
 
 
-class CordDrag(Interaction):
+class CordDrag(_AirOn):
     """Drag on every segment of ``cord`` (a network seen as points with segments; its
     ``thickness`` is the cord's radius) and on its ``bows`` (point indices), from the wind at
     each segment's middle and each bow, at the cord's own time (``kernels.aero``: cross-flow
@@ -109,10 +119,7 @@ class CordDrag(Interaction):
         area = require_nonnegative(name, "bow_area", params.bow_area, "m^2")
         self.cd_area = np.full(len(self.bows), 0.5 * rho * require_nonnegative(
             name, "bow_drag", params.bow_drag) * area)
-        self._idx = np.arange(n)
-        self._f = np.zeros((n, 3))
-        self._dfdx = np.zeros((n, 3, 3))
-        self._dfdv = np.zeros((n, 3, 3))
+        self._buffers(n)
         self._mid = np.zeros((len(self.seg), 3))
 
     def forces(self, with_jacobian=False):
@@ -130,8 +137,3 @@ class CordDrag(Interaction):
                                            self.cd_area, self._f, self._dfdv, with_jacobian)
         return self._f, self._dfdv, total
 
-    def exchange(self, to_primary, to_secondary):
-        f, dfdv, total = self.forces(self.body.jacobians)
-        if to_secondary:
-            self.body.apply(self._idx, f, self._dfdx, dfdv)
-        return -total, np.zeros(3), True
