@@ -78,9 +78,26 @@ def calibration(repeats: int = 5) -> dict:
     return {"kernel": "spring chain, 100 nodes x 1,000,000 symplectic Euler steps", **stats(samples)}
 
 
+def _calibrate(o, unit: float):
+    """Beside every timing statistic (a dict with "median" and "samples", from ``stats``) in
+    o, its median over the calibration kernel's: a figure that compares across days."""
+    if isinstance(o, dict):
+        if "median" in o and "samples" in o:
+            o["median_over_calibration"] = o["median"] / unit
+        for v in o.values():
+            _calibrate(v, unit)
+    elif isinstance(o, list):
+        for v in o:
+            _calibrate(v, unit)
+
+
 def write_json(out_dir, name: str, result: dict) -> Path:
-    """Write ``result`` to out_dir/name atomically (temp file, then rename); returns the path."""
+    """Write ``result`` to out_dir/name atomically (temp file, then rename); returns the path.
+    Every timing statistic gets its ratio to the calibration kernel timed in ``machine()``."""
     result.setdefault("machine", {})["load_average_after"] = list(os.getloadavg())
+    cal = result["machine"].get("calibration")
+    if cal is not None:
+        _calibrate({k: v for k, v in result.items() if k != "machine"}, cal["median"])
     out = Path(out_dir) / name
     with atomic_path(out) as tmp:
         tmp.write_text(json.dumps(result, indent=2))

@@ -205,20 +205,20 @@ def _json_default(o):
     raise TypeError(type(o).__name__)
 
 
-def _finite(o):
+def finite(o):
     """``o`` with every non-finite float replaced by None (JSON has no NaN or inf)."""
     if isinstance(o, float):
         return o if math.isfinite(o) else None
     if isinstance(o, dict):
-        return {k: _finite(v) for k, v in o.items()}
+        return {k: finite(v) for k, v in o.items()}
     if isinstance(o, (list, tuple)):
-        return [_finite(v) for v in o]
+        return [finite(v) for v in o]
     if isinstance(o, (np.generic, np.ndarray)):
-        return _finite(_json_default(o))
+        return finite(_json_default(o))
     return o
 
 
 def strict_json(doc, **kw) -> str:
     """``doc`` as strict JSON (RFC 8259): NaN and inf, which no JSON parser must accept,
     become null; anything else unknown is an error."""
-    return json.dumps(_finite(doc), allow_nan=False, default=_json_default, **kw)
+    return json.dumps(finite(doc), allow_nan=False, default=_json_default, **kw)
