@@ -67,7 +67,7 @@ def test_the_pass_wall_time_leaves_compilation_out_and_the_summary_reports_it():
     wall = time.perf_counter() - t0
     p = result.passes[0]
     t = result.timings()
-    assert p["compile_s"] > 0.05  # a kernel's compile takes tenths of a second, never 0
+    assert p["compile_s"] > 0.01  # a kernel's compile: 0.04 s on an idle core, never 0
     assert t["compile_s"] == p["compile_s"]
     # the two add up to the pass's wall time, which is inside the whole run's
     assert p["wall_s"] + p["compile_s"] <= result.total_s <= wall
