@@ -1,4 +1,4 @@
-"""The ``interplay`` command: list, run, compare, fit-standin and view.
+"""The ``interplay`` command: list, run, compare, fit-standin, tune (cli/tune.py) and view.
 
 Errors a user can cause print one line (no traceback) and exit with status 2.
 """
@@ -73,12 +73,16 @@ def _parser():
     _scene_options(run)
     run.add_argument("--coupling", default=None,
                      help="two-way | one-way | hybrid (default: the scene's own)")
+    run.add_argument("--controller", default=None, metavar="FILE",
+                     help="controller parameters from `interplay tune` (controller.json)")
     _output_options(run)
     cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
     _scene_options(cmp_)
     _output_options(cmp_)
     fit = sub.add_parser("fit-standin", help="fit the hybrid stand-in to a two-way run")
     _scene_options(fit)
+    from .tune import add_parser as add_tune
+    add_tune(sub)
     view = sub.add_parser("view", help="serve a saved run in a web viewer on localhost")
     view.add_argument("dir", help="a run directory, e.g. out/basketball/two-way")
     view.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
@@ -98,6 +102,9 @@ def _build_kwargs(args):
         if not eq or not key:
             raise ParameterError(f"--set {item}: expected KEY=VALUE")
         assignments[key.strip()] = value.strip()
+    if getattr(args, "controller", None):  # a tuned controller; --set still overrides it
+        from .tune import controller_sets
+        assignments = {**controller_sets(spec, args.controller), **assignments}
     kw = {"params": P.apply(spec.params(), assignments), "fps": args.fps or spec.fps,
           "duration": args.duration if args.duration is not None else spec.duration}
     integrator = spec.check_integrator(args.integrator)
@@ -176,13 +183,18 @@ def _vec(v):
     return "(" + ", ".join(f"{x:.3f}" for x in v) + ")"
 
 
+def cmd_tune(args, console):
+    from .tune import cmd_tune as tune
+    tune(args, console)
+
+
 def cmd_view(args, console):
     from .viewer import serve
     serve(args.dir, host=args.host, port=args.port, log=lambda m: print(m, flush=True))
 
 
 COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit,
-            "view": cmd_view}
+            "tune": cmd_tune, "view": cmd_view}
 
 
 def main(argv=None) -> int:

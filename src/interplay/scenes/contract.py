@@ -21,7 +21,8 @@ class SceneSpec:
     ``interplay fit-standin`` can fit them, with fit_time (s): the time at which the
     primary's velocity is matched; camera: its default preview camera (None: frame every
     system); figures: result -> {label: value}, the scene's own key figures (the basketball's
-    exit speed) for summaries and compare tables.
+    exit speed) for summaries and compare tables; tune: its controller search
+    (control/search.TuneProblem) for ``interplay tune``, None for none.
     """
     name: str
     description: str
@@ -35,6 +36,7 @@ class SceneSpec:
     fit_time: float | None = None
     camera: object = None
     figures: Callable | None = field(default=None, compare=False)
+    tune: object = field(default=None, compare=False)
 
     @property
     def default_coupling(self) -> str:

@@ -128,6 +128,10 @@ class RigidParts(ABC):
         """Add a force (N) at a world point to a part (see BodiesView.apply); systems that
         cannot be pushed ignore it."""
 
+    def mark_touching(self, parts):
+        """Parts (indices) a contact touched this step, for the system's own sensors (a
+        figure's foot-contact events); ignored by systems without sensors."""
+
 
 class BodiesView(_View):
     """Rigid parts. ``names`` (k,); ``meshes`` [(vertices (v,3), triangles (t,3))] in each
@@ -188,6 +192,12 @@ class BodiesView(_View):
         Ignored when the system cannot be pushed."""
         if self.movable:
             self.system.add_part_wrench(part, force, torque, point, dfdx, dfdv)
+
+    def touched(self, parts) -> None:
+        """Tell the system that a contact touches these parts (indices) this step: sensing,
+        not force (a figure's state machine reads foot contact from it)."""
+        if self.movable:
+            self.system.mark_touching(parts)
 
 
 class ShapeView(_View):

@@ -1,0 +1,193 @@
+"""The bounce controller: a gymnast's straight bounce on a trampoline, as a state machine in
+the style of the paper's (SPEC 2.3), with a balance law that keeps her over the bed's centre.
+
+States, each a set of joint targets (control/fsm.py):
+
+* ``flight``: straight body, toes pointed, arms overhead; at the apex (centre of mass
+  falling) she hands over to
+* ``descend``: the legs prepare for landing (knees and hips flexed to ``knee_land`` and
+  ``hip_land``, feet flat, stiff stance gains ``leg_omega``), arms come down in front; on
+  foot contact
+* ``absorb``: the legs hold their flexion against the bed while it is depressed, for
+  ``thrust_delay`` s, then
+* ``thrust``: hips, knees and ankles extend (velocity targets scaled by ``power``, the
+  ankles to ``ankle_push``) timed to the bed's recoil, and the arms swing up to
+  ``arm_swing``; when both feet leave the bed she is in ``flight`` again.
+
+Balance (``BounceBalance``, the figure's feedback at every control tick), after Raibert's
+hopping machines: in the air the legs are placed for the landing, hip flexion (forward-back)
+and abduction (sideways) turned so the feet land ahead of the centre of mass by
+``k_speed`` v + ``k_place`` (c - c0) along each axis (v the centre of mass's horizontal
+velocity, c - c0 its offset from the bed's centre), which brakes a drift and steers her back;
+on the bed the hips servo the pelvis upright against the planted legs (``k_attitude`` of the
+legs' lean), which stops the body rotating. Offsets slew at most SLEW so a new phase does not
+kick the servos.
+
+Angles in rad (anatomical sense: flexion positive; ankle flexion is dorsiflexion), times in
+s, gains as stated. The defaults of ``BounceParams`` are the output of ``interplay tune
+trampoline`` (control/search.py simulated annealing; docs/trampoline.md).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..geometry.anthropometry import SEGMENTS
+from .fsm import Controller, State, Transition
+
+SLEW = 4.0  # rad/s: the balance offsets' fastest change
+PLACE_MAX = 0.35  # rad: the largest leg angle the foot placement asks for
+LEG_LENGTH = 0.85  # m: hip to sole of the default 1.70 m gymnast, for the placement angle
+EXTEND = 8.0  # 1/s: the thrust's extension rate, as a share of the crouch per second, at power 1
+
+
+@dataclass(frozen=True)
+class BounceParams:
+    """The bounce controller's free parameters (the search's variables; units in the module
+    docstring): landing posture knee_land (rad; the ankles and hips bend by half of it so the
+    hips stay over the ankles), lean (rad of extra ankle flexion: the body forward over the
+    middle of the feet) and trunk (rad of extra hip flexion);
+    leg_omega (rad/s): the stance legs' servo frequency; thrust_delay (s) after touchdown;
+    power (-): the extension's velocity targets; ankle_push (rad, negative: plantarflexion);
+    arm_swing (rad of shoulder abduction at takeoff: the arms rise sideways, so the two
+    arms' angular momenta cancel and the swing does not tip her), arm_land (rad); foot
+    placement k_speed (s), k_place (-); on the bed, the ankles' feedback on the centre of
+    mass's lead over the feet k_lead (rad/m), on its velocity k_drift (rad s/m) and on the
+    body's angular momentum k_spin (rad per kg m^2/s), and the hips' servo of the pelvis
+    upright against the legs' lean, k_attitude (-)."""
+    knee_land: float = 0.45
+    lean: float = 0.1
+    trunk: float = 0.0
+    leg_omega: float = 12.0
+    thrust_delay: float = 0.12
+    power: float = 1.0
+    ankle_push: float = 0.2
+    arm_swing: float = 2.8
+    arm_land: float = 0.6
+    k_speed: float = 0.3
+    k_place: float = 0.3
+    k_lead: float = 5.0
+    k_drift: float = 0.3
+    k_spin: float = 0.02
+    k_attitude: float = 0.0
+
+    def validated(self) -> "BounceParams":
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise ParameterError(f"bounce controller: {f.name} must be a finite number, "
+                                     f"got {v!r}")
+        if not (self.leg_omega > 0 and self.thrust_delay >= 0 and self.power > 0):
+            raise ParameterError("bounce controller: leg_omega and power must be positive and "
+                                 f"thrust_delay >= 0 s, got {self.leg_omega}, {self.power}, "
+                                 f"{self.thrust_delay}")
+        return self
+
+
+#: the search's box: name -> (low, high), in the units above
+BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4), "leg_omega": (6.0, 20.0),
+          "thrust_delay": (0.0, 0.3), "power": (0.3, 2.0), "ankle_push": (-0.6, 0.1),
+          "arm_swing": (1.5, 3.1), "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6),
+          "k_place": (0.0, 1.0), "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5),
+          "k_spin": (0.0, 0.05), "k_attitude": (0.0, 1.2)}
+
+
+def controller(p: BounceParams) -> Controller:
+    """flight -> descend -> absorb -> thrust -> flight, starting in descend (she is dropped
+    from her first apex)."""
+    p = p.validated()
+    legs = (("hip", p.leg_omega), ("knee", p.leg_omega), ("ankle", p.leg_omega))
+    flight = State("flight", pose=(("hip", 0.0), ("knee", 0.05), ("ankle", -0.3), ("waist", 0.0),
+                                   ("neck", 0.0), ("shoulder_flex", 0.0),
+                                   ("shoulder_abd", p.arm_swing), ("elbow", 0.05),
+                                   ("toe", 0.0)),
+                   transitions=(Transition("com_falling", "descend"),), blend=0.15)
+    descend = State("descend", pose=(("hip_flex", 0.5 * p.knee_land + p.trunk),
+                                     ("hip_abd", 0.0), ("knee", p.knee_land),
+                                     ("ankle", 0.5 * p.knee_land + p.lean),
+                                     ("shoulder_abd", p.arm_land), ("elbow", 0.1)),
+                    gains=legs, support=True, blend=0.4,
+                    transitions=(Transition("foot_contact", "absorb"),))
+    absorb = State("absorb", gains=legs, support=True, blend=0.0,
+                   transitions=(Transition("time", "thrust", p.thrust_delay),
+                                Transition("no_foot_contact", "flight")))
+    thrust = State("thrust", pose=(("hip_flex", 0.0), ("knee", 0.0), ("ankle", p.ankle_push),
+                                   ("shoulder_abd", p.arm_swing), ("elbow", 0.0)),
+                   # velocity targets in proportion to the crouch, so the hips rise over
+                   # the feet instead of swinging behind them
+                   velocity=(("hip_flex", -EXTEND * p.power * (0.5 * p.knee_land + p.trunk)),
+                             ("knee", -EXTEND * p.power * p.knee_land),
+                             ("ankle", -EXTEND * p.power * (0.5 * p.knee_land + p.lean
+                                                            - p.ankle_push)),
+                             ("shoulder_abd", 8.0)),
+                   gains=legs, support=True, blend=0.0,
+                   transitions=(Transition("no_foot_contact", "flight"),))
+    return Controller((flight, descend, absorb, thrust), start="descend")
+
+
+class BounceBalance:
+    """The figure's feedback (systems/figure.py): joint offsets (rad), foot placement in the
+    air and the ankles' balance on the bed; centre (m): the bed's centre (x, y)."""
+
+    def __init__(self, p: BounceParams, joints, centre=(0.0, 0.0)):
+        self.p = p.validated()
+        self.centre = np.asarray(centre, float)
+        idx = {n: i for i, n in enumerate(joints)}
+        self.flex = np.array([idx["l_hip_flex"], idx["r_hip_flex"]])
+        self.ankles = np.array([idx["l_ankle"], idx["r_ankle"]])
+        self.thighs = [SEGMENTS.index("l_thigh"), SEGMENTS.index("r_thigh")]
+        self.abd_l, self.abd_r = idx["l_hip_abd"], idx["r_hip_abd"]
+        self.out = np.zeros(len(joints))
+
+    def capture(self) -> dict:
+        return {"out": self.out.copy()}
+
+    def restore(self, snap: dict):
+        if snap:
+            self.out[:] = snap["out"]
+
+    def offsets(self, fig, sensors) -> np.ndarray:
+        d = fig.data
+        R = d.xmat[fig.root].reshape(3, 3)
+        fwd = R[:, 0].copy()
+        fwd[2] = 0.0
+        fwd /= max(np.linalg.norm(fwd), 1e-9)
+        left = np.array([-fwd[1], fwd[0], 0.0])
+        p = self.p
+        com, v = sensors["com"], sensors["com_vel"]
+        want = np.zeros_like(self.out)
+        if len(fig.feet_touching()):
+            # on the bed: the ankle strategy, steering the pressure under the feet to keep the
+            # centre of mass over them and the body from rotating
+            lead = (com - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ fwd
+            spin = d.subtree_angmom[fig.root] @ left  # > 0: pitching forward
+            want[self.ankles] = -(p.k_lead * lead + p.k_drift * (v @ fwd) + p.k_spin * spin)
+            # and the hips: flexed by the legs' lean, the pelvis is held upright over them
+            leg = (d.geom_xpos[fig.sole_geoms].mean(axis=0)
+                   - d.xpos[fig.seg_body[self.thighs]].mean(axis=0))
+            want[self.flex] = p.k_attitude * math.atan2(leg @ fwd, -leg[2])
+            side = p.k_attitude * math.atan2(leg @ left, -leg[2])
+            want[self.abd_l], want[self.abd_r] = side, -side
+        else:
+            # in the air: place the feet ahead of the centre of mass to brake and steer back,
+            # the hips turned against the pelvis's pitch and roll so the legs aim in the world
+            up = R[:, 2]
+            pitch = math.atan2(up @ fwd, up[2])  # pelvis leaning forward: > 0
+            roll = math.atan2(-(up @ left), up[2])  # leaning to her right: > 0
+            c = com[:2] - self.centre
+
+            def angle(a):
+                return float(np.clip(math.asin(np.clip(a / LEG_LENGTH, -1.0, 1.0)),
+                                     -PLACE_MAX, PLACE_MAX))
+            tilt = PLACE_MAX
+            along = angle(p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2]))
+            side = angle(p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2]))
+            want[self.flex] = along + float(np.clip(pitch, -tilt, tilt))
+            want[self.abd_l] = side - float(np.clip(roll, -tilt, tilt))
+            want[self.abd_r] = -want[self.abd_l]
+        step = SLEW * fig.control_dt
+        self.out[:] = np.clip(want, self.out - step, self.out + step)
+        return self.out
