@@ -79,11 +79,12 @@ def tune(spec, params, coupling=None, budget=None, seed=0, workers=None, log=pri
             f"{time.perf_counter() - t0:.0f} s")
     if workers == 1:
         res = anneal(trial, values, tp.bounds, budget, seed, t_start=1.0, t_end=0.01,
-                     progress=progress)
+                     progress=progress, coordinates=tp.coordinates)
     else:
         with ProcessPoolExecutor(max_workers=workers) as pool:
             res = anneal(trial, values, tp.bounds, budget, seed, t_start=1.0, t_end=0.01,
-                         batch=workers, map_fn=pool.map, progress=progress)
+                         batch=workers, map_fn=pool.map, progress=progress,
+                         coordinates=tp.coordinates)
     best = dataclasses.replace(base, **res.best)
     metrics = next(r["metrics"] for r in res.evaluations if r["loss"] == res.loss)
     doc = {"scene": spec.name, "field": tp.field, "params": dataclasses.asdict(best),

@@ -41,6 +41,7 @@ from .fsm import Controller, State, Transition
 SLEW = 4.0  # rad/s: the balance offsets' fastest change
 PLACE_MAX = 0.35  # rad: the largest leg angle the foot placement asks for
 LEG_LENGTH = 0.85  # m: hip to sole of the default 1.70 m gymnast, for the placement angle
+ARM_RANGE = (-1.0, 2.5)  # rad: how far the circling arms may go from their pose
 EXTEND = 8.0  # 1/s: the thrust's extension rate, as a share of the crouch per second, at power 1
 
 
@@ -57,7 +58,14 @@ class BounceParams:
     placement k_speed (s), k_place (-); on the bed, the ankles' feedback on the centre of
     mass's lead over the feet k_lead (rad/m), on its velocity k_drift (rad s/m) and on the
     body's angular momentum k_spin (rad per kg m^2/s), and the hips' servo of the pelvis
-    upright against the legs' lean, k_attitude (-)."""
+    upright against the legs' lean, k_attitude (-); in the air, k_turn (m per kg m^2/s):
+    the feet land that much behind the centre of mass per unit of the body's backward
+    angular momentum, so the bed's push on the next landing turns the spin back; on the bed,
+    k_hip_spin (rad per kg m^2/s): the hips extend against a backward spin (and flex against
+    a forward one), which turns the legs' push on the bed, and with it the bed's friction
+    under the feet a metre below the centre of mass, against the spin; k_arms (-): the share
+    of the body's pitch spin the arms take in the air by circling (forward against a
+    backward spin), so the trunk lands upright, a trampolinist's correction."""
     knee_land: float = 0.45
     lean: float = 0.1
     trunk: float = 0.0
@@ -73,6 +81,9 @@ class BounceParams:
     k_drift: float = 0.3
     k_spin: float = 0.02
     k_attitude: float = 0.0
+    k_turn: float = 0.0
+    k_hip_spin: float = 0.0
+    k_arms: float = 0.0
 
     def validated(self) -> "BounceParams":
         for f in fields(self):
@@ -92,7 +103,9 @@ BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4), "l
           "thrust_delay": (0.0, 0.3), "power": (0.3, 2.0), "ankle_push": (-0.6, 0.1),
           "arm_swing": (1.5, 3.1), "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6),
           "k_place": (0.0, 1.0), "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5),
-          "k_spin": (0.0, 0.05), "k_attitude": (0.0, 1.2)}
+          "k_spin": (0.0, 0.05), "k_attitude": (0.0, 1.2),
+          "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
+          "k_arms": (0.0, 1.5)}
 
 
 def controller(p: BounceParams) -> Controller:
@@ -114,11 +127,14 @@ def controller(p: BounceParams) -> Controller:
     absorb = State("absorb", gains=legs, support=True, blend=0.0,
                    transitions=(Transition("time", "thrust", p.thrust_delay),
                                 Transition("no_foot_contact", "flight")))
-    thrust = State("thrust", pose=(("hip_flex", 0.0), ("knee", 0.0), ("ankle", p.ankle_push),
+    # the extension keeps the trunk's tilt in the world (trunk + lean, forward): the hips open
+    # by exactly what the thighs turn, so no part of the body is swung round against the bed
+    # and the push adds no spin; velocities in proportion, so the hips rise over the feet
+    hip_end = p.trunk + p.lean - p.ankle_push
+    thrust = State("thrust", pose=(("hip_flex", hip_end), ("knee", 0.0), ("ankle", p.ankle_push),
                                    ("shoulder_abd", p.arm_swing), ("elbow", 0.0)),
-                   # velocity targets in proportion to the crouch, so the hips rise over
-                   # the feet instead of swinging behind them
-                   velocity=(("hip_flex", -EXTEND * p.power * (0.5 * p.knee_land + p.trunk)),
+                   velocity=(("hip_flex", -EXTEND * p.power * (0.5 * p.knee_land + p.trunk
+                                                              - hip_end)),
                              ("knee", -EXTEND * p.power * p.knee_land),
                              ("ankle", -EXTEND * p.power * (0.5 * p.knee_land + p.lean
                                                             - p.ankle_push)),
@@ -139,6 +155,8 @@ class BounceBalance:
         self.flex = np.array([idx["l_hip_flex"], idx["r_hip_flex"]])
         self.ankles = np.array([idx["l_ankle"], idx["r_ankle"]])
         self.thighs = [SEGMENTS.index("l_thigh"), SEGMENTS.index("r_thigh")]
+        self.shoulders = np.array([idx["l_shoulder_flex"], idx["r_shoulder_flex"]])
+        self.arms = None  # kg m^2: the arms' inertia about the shoulders' axis (first tick)
         self.abd_l, self.abd_r = idx["l_hip_abd"], idx["r_hip_abd"]
         self.out = np.zeros(len(joints))
 
@@ -168,8 +186,10 @@ class BounceBalance:
             # and the hips: flexed by the legs' lean, the pelvis is held upright over them
             leg = (d.geom_xpos[fig.sole_geoms].mean(axis=0)
                    - d.xpos[fig.seg_body[self.thighs]].mean(axis=0))
-            want[self.flex] = p.k_attitude * math.atan2(leg @ fwd, -leg[2])
-            side = p.k_attitude * math.atan2(leg @ left, -leg[2])
+            want[self.flex] = (p.k_attitude * math.atan2(leg @ fwd, -leg[2])
+                               + p.k_hip_spin * spin)
+            side = (p.k_attitude * math.atan2(leg @ left, -leg[2])
+                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd))
             want[self.abd_l], want[self.abd_r] = side, -side
         else:
             # in the air: place the feet ahead of the centre of mass to brake and steer back,
@@ -178,16 +198,47 @@ class BounceBalance:
             pitch = math.atan2(up @ fwd, up[2])  # pelvis leaning forward: > 0
             roll = math.atan2(-(up @ left), up[2])  # leaning to her right: > 0
             c = com[:2] - self.centre
+            spin = d.subtree_angmom[fig.root]  # kg m^2/s: forward pitch about +left
+            turn_fwd = p.k_turn * (spin @ left)  # spinning forward: land with the feet ahead
+            turn_side = -p.k_turn * (spin @ fwd)  # rolling to her right: feet to the right
 
             def angle(a):
                 return float(np.clip(math.asin(np.clip(a / LEG_LENGTH, -1.0, 1.0)),
                                      -PLACE_MAX, PLACE_MAX))
             tilt = PLACE_MAX
-            along = angle(p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2]))
-            side = angle(p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2]))
+            along = angle(p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2])
+                          + turn_fwd)
+            side = angle(p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2])
+                         + turn_side)
             want[self.flex] = along + float(np.clip(pitch, -tilt, tilt))
             want[self.abd_l] = side - float(np.clip(roll, -tilt, tilt))
             want[self.abd_r] = -want[self.abd_l]
         step = SLEW * fig.control_dt
         self.out[:] = np.clip(want, self.out - step, self.out + step)
+        # the arms circle in the air against the body's pitch spin (the offset integrates the
+        # rate r = -k L / I_arms: shoulder flexion turns the arms about -left), and come back
+        # on the bed
+        if self.arms is None:
+            self.arms = arm_inertia(fig)
+        if len(fig.feet_touching()):
+            self.out[self.shoulders] = self.out[self.shoulders] - np.clip(
+                self.out[self.shoulders], -step, step)
+        else:
+            rate = -p.k_arms * (d.subtree_angmom[fig.root] @ left) / self.arms
+            self.out[self.shoulders] = np.clip(self.out[self.shoulders]
+                                               + rate * fig.control_dt, *ARM_RANGE)
         return self.out
+
+
+def arm_inertia(fig) -> float:
+    """(kg m^2) both arms' moment of inertia about the line through the shoulders, at rest
+    hanging: sum m_i (d_i^2) + I_i over the upper arms, forearms and hands."""
+    m, d = fig.model, fig.data
+    total = 0.0
+    for side in ("l", "r"):
+        shoulder = d.xpos[fig.seg_body[SEGMENTS.index(f"{side}_upper_arm")]]
+        for seg in ("upper_arm", "forearm", "hand"):
+            b = fig.seg_body[SEGMENTS.index(f"{side}_{seg}")]
+            r = d.xipos[b] - shoulder
+            total += m.body_mass[b] * (r[0] ** 2 + r[2] ** 2) + m.body_inertia[b][1]
+    return float(total)

@@ -22,6 +22,7 @@ from .search import TuneProblem
 TILT_GOOD = 0.35  # rad: the pelvis's largest tilt from vertical at a good landing
 TILT_FALLEN = 1.0  # rad: past this she has fallen (the trial stops)
 HEIGHT_KEPT = 0.75  # a good bounce's flight is at least this share of the first one's
+SPIN_SCALE = 5.0  # kg m^2/s: a takeoff spin that turns her ~0.35 rad in a 1 s flight
 DURATION = 14.0  # s of a search trial: the drop and about seven bounces
 
 
@@ -113,9 +114,9 @@ def rises(record: BounceRecord) -> np.ndarray:
 def score(record: BounceRecord, centre=(1.0, 0.5)) -> tuple[float, dict]:
     """(loss, metrics) of a trial: minus the good bounces in a row (landed upright, inside the
     central zone of half extents ``centre`` m, from a flight at least HEIGHT_KEPT of the
-    first's: she keeps bouncing, not just standing), plus half the mean horizontal speed (m/s) and
-    a twentieth of the mean angular momentum (kg m^2/s) at the takeoffs before the first bad
-    landing (what makes the next landing bad: these guide a search that bounces only once or
+    first's: she keeps bouncing, not just standing), plus half the mean horizontal speed (m/s)
+    and the mean angular momentum over SPIN_SCALE (kg m^2/s) at the takeoffs before the first
+    bad landing (what makes the next landing bad: these guide a search that bounces only once or
     twice yet); with at least three, plus twice the spread
     (std / mean) of the flight heights after the second, their mean's miss of the first
     (the drop's) as a fraction, the landings' mean offset from the centre as a fraction of the
@@ -136,7 +137,7 @@ def score(record: BounceRecord, centre=(1.0, 0.5)) -> tuple[float, dict]:
     if len(offs):
         speed, spin = float(offs[:, 1].mean()), float(offs[:, 2].mean())
         metrics.update(takeoff_speed=speed, takeoff_spin=spin)
-        loss += 0.5 * speed + spin / 20.0
+        loss += 0.5 * speed + spin / SPIN_SCALE
     if good >= 3:
         later = rise[2:]
         spread = float(np.std(later) / np.mean(later))
@@ -163,15 +164,16 @@ def evaluate(task) -> tuple[float, dict]:
 HAND_START = {"knee_land": 0.2, "lean": 0.0, "trunk": 0.0, "leg_omega": 12.0,
               "thrust_delay": 0.12, "power": 1.0, "ankle_push": 0.2, "arm_swing": 2.8,
               "arm_land": 0.6, "k_speed": 0.15, "k_place": 0.05, "k_lead": 5.0,
-              "k_drift": 0.3, "k_spin": 0.02, "k_attitude": 0.3}
+              "k_drift": 0.3, "k_spin": 0.02, "k_attitude": 0.3, "k_turn": 0.0,
+              "k_hip_spin": 0.0, "k_arms": 0.0}
 #: where the two-way search begins: the stand-in search's result (``interplay tune
 #: trampoline --coupling hybrid --budget 400 --seed 0``; tune on the stand-in, finish
 #: two-way)
-STANDIN_RESULT = {"knee_land": 0.5161, "lean": 0.1446, "trunk": 0.0593, "leg_omega": 8.2683, "thrust_delay": 0.3, "power": 0.3, "ankle_push": -0.4271, "arm_swing": 2.485, "arm_land": 0.0916, "k_speed": 0.3803, "k_place": 0.1034, "k_lead": 2.3935, "k_drift": 1.5, "k_spin": 0.011, "k_attitude": 1.2}
+STANDIN_RESULT = {"knee_land": 0.5161, "lean": 0.1446, "trunk": 0.0593, "leg_omega": 8.2683, "thrust_delay": 0.3, "power": 0.3, "ankle_push": -0.4271, "arm_swing": 2.485, "arm_land": 0.0916, "k_speed": 0.3803, "k_place": 0.1034, "k_lead": 2.3935, "k_drift": 1.5, "k_spin": 0.011, "k_attitude": 1.2, "k_turn": 0.0, "k_hip_spin": 0.0, "k_arms": 0.0}
 
 TUNE = TuneProblem(field="bounce", bounds=BOUNDS, evaluate=evaluate,
                    starts={"two-way": STANDIN_RESULT, "hybrid": HAND_START},
-                   duration=DURATION, budget=100)
+                   duration=DURATION, budget=100, coordinates=3)
 
 
 def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float]:

@@ -42,13 +42,14 @@ class TuneProblem:
     module-level function so a process pool can run it; starts: coupling -> {name: value},
     where each search begins (fixed, so a search repeats from its seed whatever the current
     defaults are), the couplings it may run in, default first; duration (s) of a trial;
-    budget: default evaluations."""
+    budget: default evaluations; coordinates: parameters a proposal moves (None: all)."""
     field: str
     bounds: dict
     evaluate: Callable
     starts: dict
     duration: float = 10.0
     budget: int = 100
+    coordinates: int | None = None
 
     @property
     def couplings(self) -> tuple:
@@ -64,13 +65,15 @@ def _split(value):
 
 def anneal(loss, start: dict, bounds: dict, evaluations: int = 100, seed: int = 0,
            t_start: float = 0.3, t_end: float = 0.003, step: float = 0.25, batch: int = 1,
-           map_fn=map, progress=None) -> SearchResult:
+           map_fn=map, progress=None, coordinates: int | None = None) -> SearchResult:
     """Minimise ``loss(params: dict) -> float`` (or (float, metrics)) from ``start`` over
     ``bounds`` (name -> (lo, hi)); step: the proposal's standard deviation as a fraction of
     each range (shrinking with the temperature); t_start, t_end: the temperature (in units of
     loss) at the first and last evaluation; batch: candidates evaluated together through
     ``map_fn(loss, [params, ...])``; progress(done, evaluations, best loss) after each
-    batch."""
+    batch; coordinates: how many parameters, chosen at random, a proposal moves (None: all;
+    with many parameters a move of all at once rarely improves on a good point, a move of
+    a few does)."""
     names = list(bounds)
     missing = [k for k in names if k not in start]
     if missing:
@@ -97,7 +100,12 @@ def anneal(loss, start: dict, bounds: dict, evaluations: int = 100, seed: int = 
             frac = (i + b) / max(evaluations - 1, 1)
             temp = t_start * (t_end / t_start) ** frac
             scale = step * (hi - lo) * math.sqrt(temp / t_start)
-            proposals.append((np.clip(x + rng.normal(0.0, 1.0, len(x)) * scale, lo, hi), temp))
+            move = rng.normal(0.0, 1.0, len(x)) * scale
+            if coordinates is not None and coordinates < len(x):
+                keep = np.zeros(len(x), dtype=bool)
+                keep[rng.choice(len(x), coordinates, replace=False)] = True
+                move[~keep] = 0.0
+            proposals.append((np.clip(x + move, lo, hi), temp))
         values = map_fn(loss, [dict(zip(names, y)) for y, _ in proposals])
         for (y, temp), value in zip(proposals, values):
             fy, metrics = _split(value)

@@ -12,9 +12,9 @@ d_i - (D - pocket) of the bed's vertical force
 a polynomial fitted (``fit_curve``) to the full bed's static load-deflection under a load on
 a 0.3 m square (scenes/trampoline.load_deflection): not a spring's straight line, since the
 bed hangs on horizontal springs and stiffens as it is pressed into a funnel (Kraft 2001).
-Tangentially the parts cannot slide: a viscous force -friction_damping v per point against
-its part's horizontal velocity (a foot may still roll in the pocket that holds it), capped at
-mu times the point's normal share. A stand-in has no mass,
+Tangentially the points cannot slide: a viscous force -friction_damping v per point against
+its horizontal velocity (a foot turning in the pocket drags its toes over the bed, as on the
+real one), capped at mu times the point's normal share. A stand-in has no mass,
 no horizontal pull towards the bed's centre and no recoil lag of its own: what the two-way run
 adds is measured in docs/trampoline.md.
 """
@@ -133,7 +133,7 @@ class BedSprings(StandIn):
         share = fz * d / d.sum()
         f = np.zeros((len(on), 3))
         f[:, 2] = share
-        vt = lin[part, :2]
+        vt = v[:, :2]
         speed = np.linalg.norm(vt, axis=1)
         cap = np.minimum(p.friction_damping, p.friction * share / np.maximum(speed, 1e-12))
         f[:, :2] = -cap[:, None] * vt

@@ -143,6 +143,15 @@ class PartContact(Interaction):
     def prepare(self, h, dts=None):
         self._h = h
 
+    def capture(self) -> dict:
+        """The stand-in's memory (the rigid-parts contact itself keeps none between steps)."""
+        cap = getattr(self.standin, "capture", None)
+        return {f"standin_{k}": v for k, v in cap().items()} if cap else {}
+
+    def restore(self, snap: dict):
+        if self.standin is not None and hasattr(self.standin, "restore"):
+            self.standin.restore({k[8:]: v for k, v in snap.items() if k.startswith("standin_")})
+
     def _motion(self):
         """Copy the parts' state now into the bundle."""
         P, v = self.parts, self.view
