@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_THREADING_LAYER ?= workqueue
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: clean-numba demo test test-all bench bench-cloth clean sysdeps browser
+.PHONY: clean-numba demo test test-all bench bench-cloth clean sysdeps browser fuzz
 
 # The preview renderer needs Mesa's EGL driver (headless OpenGL on the CPU); the slow browser
 # tests need Chromium. apt runs only when something is missing, and only as root.
@@ -55,3 +55,7 @@ clean:
 # Numba's cache does not track kernels called across modules: clear it after editing kernels.
 clean-numba:
 	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
+
+# hostile-input fuzzing of every surface (docs/robustness.md): ~5,000 cases, 15-60 min
+fuzz: $(STAMP)
+	$(BIN)/python benchmarks/fuzz.py --out out/bench

@@ -49,21 +49,30 @@ def test_list(capsys):
 BAD = [
     (["run", "nowhere"], "unknown scene 'nowhere'"),
     (["run", "basketball", "--coupling", "sideways"], "unknown coupling"),
-    (["run", "basketball", "--set", "ball.mass=-1"], "mass must be a positive"),
-    (["run", "basketball", "--set", "ball.mass=0"], "mass must be a positive"),
-    (["run", "basketball", "--set", "ball.radius=0"], "radius must be a positive"),
-    (["run", "basketball", "--set", "net.cord_ea=-5"], "cord_ea must be a positive"),
-    (["run", "basketball", "--set", "contact.stiffness=0"], "contact stiffness must be"),
-    (["run", "basketball", "--dt", "0"], "dt must be a positive"),
-    (["run", "basketball", "--duration", "-1"], "duration must be a positive"),
-    (["run", "basketball", "--duration", "0"], "duration must be a positive"),
+    (["run", "basketball", "--set", "ball.mass=-1"], "ball.mass=-1: out of range; ball.mass "
+     "must be a finite number >= 0.0001 and <= 1e+06 kg"),
+    (["run", "basketball", "--set", "ball.mass=0"], "ball.mass must be a finite number >= 0.0001"),
+    (["run", "basketball", "--set", "ball.radius=0"], "ball.radius must be a finite number >= 0.001"),
+    (["run", "basketball", "--set", "net.cord_ea=-5"], "net.cord_ea must be a finite number >= 0.001"),
+    (["run", "basketball", "--set", "contact.stiffness=0"], "contact.stiffness must be"),
+    (["run", "basketball", "--dt", "0"], "--dt 0: out of range; --dt must be a finite number "
+     ">= 1e-12 and <= 1 s"),
+    (["run", "basketball", "--duration", "-1"], "--duration must be a finite number >= 1e-06"),
+    (["run", "basketball", "--duration", "0"], "--duration must be a finite number >= 1e-06"),
     (["run", "basketball", "--set", "net.colour=red"], "unknown parameter; valid keys"),
-    (["run", "basketball", "--set", "ball.mass=heavy"], "expected a float"),
+    (["run", "basketball", "--set", "ball.mass=heavy"], "'heavy' is not a number"),
     (["run", "basketball", "--set", "nomass"], "expected KEY=VALUE"),
     (["run", "basketball", "--integrator", "rk4"], "choose one of explicit, implicit, localglobal"),
     (["run", "basketball", "--integrator", "explicit", "--dt", "1e-3"],
      "above the explicit stability bound"),
-    (["run", "basketball", "--duration", "soon"], "invalid float value"),
+    (["run", "basketball", "--duration", "soon"], "--duration soon: 'soon' is not a number"),
+    (["run", "basketball", "--set", "ball.position=0,0,nan"], "ball.position=0,0,nan: not finite"),
+    (["run", "flags", "--set", "cotton.nu=2147483648"], "cotton.nu must be a whole number >= 2"),
+    (["run", "leaves", "--set", "leaves.seed=-1"], "leaves.seed must be a whole number >= 0"),
+    (["run", "bungee", "--set", "jumper.mass=1e-308"], "jumper.mass must be a finite number >= "
+     "10 and <= 500 kg"),
+    (["run", "pond", "--set", "basin.size_x=1e-308"], "basin.size_x must be"),
+    (["run", "basketball", "--fps", "1e308"], "--fps must be a finite number >= 0.01 and <= 10000"),
 ]
 
 

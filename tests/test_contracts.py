@@ -54,9 +54,9 @@ def keyframed():
 
 def rider():
     from interplay.scenes.leaves import RiderParams, rider_path
+    from interplay.geometry.bicycle import Bicyclist
     from interplay.systems.path import PathFollower
-    v, t = shapes.bicyclist()
-    return PathFollower("bicyclist", rider_path(RiderParams()), v, t)
+    return PathFollower("bicyclist", rider_path(RiderParams()), Bicyclist())
 
 
 def mocap():
@@ -201,7 +201,7 @@ def test_refusals_come_before_any_simulation(capsys, monkeypatch):
     for argv, says in ((["fit-standin", "pond"], "pond has no stand-in that fit-standin can fit"),
                        (["compare", "flags"], "flags supports only one-way coupling"),
                        (["run", "basketball", "--set", "ball.velocity=1,2"],
-                        "ball.velocity=1,2: expected 3 numbers"),
+                        "ball.velocity=1,2: 2 numbers given; ball.velocity must be 3 "),
                        (["run", "flags", "--coupling", "hybrid"],
                         "flags supports one-way coupling, not hybrid"),
                        (["run", "pond", "--integrator", "implicit"],

@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from interplay.errors import ParameterError
+from interplay.geometry.bicycle import Bicyclist
 from interplay.geometry import mesh as M
 from interplay.geometry import shapes
 from interplay.systems.springmass import SpringNetwork
@@ -58,7 +59,7 @@ def test_generators_are_valid_meshes():
     assert M.triangle_areas(x, t).sum() == pytest.approx(np.pi * 0.25, rel=0.02)
     x, t, vein = shapes.leaf(0.12, 0.06)
     assert np.all(x[vein, 1] == 0.0)
-    M.validate(*shapes.bicyclist())
+    M.validate(*Bicyclist().mesh())
 
 
 def test_load_obj_ply_stl(tmp_path):

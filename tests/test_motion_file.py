@@ -1,13 +1,11 @@
 """BVH reading, unit and axis detection, retargeting onto the figure, bad files."""
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from interplay.io.motion_file import BVHError, read_bvh
-from interplay.systems.mocap import MocapFigure
+from interplay.systems.mocap import MocapFigure, clip_path
 
-MOCAP = Path(__file__).parents[1] / ".." / "shared" / "data" / "mocap"
+MOCAP = clip_path("x.bvh").parent  # ../shared/data/mocap beside the repository (or a worktree's)
 CLIPS = ["cmu_02_03_run.bvh", "cmu_127_03_run.bvh", "cmu_13_32_forward_jump.bvh",
          "cmu_131_01_walk_scaled.bvh", "cmu_131_03_hop_scaled.bvh"]
 

@@ -46,7 +46,9 @@ def cloth_result():
 
 def test_shapes_cover_every_form(ball_result, cloth_result):
     forms = {s.name: s.form for s in from_result(ball_result).shapes}
-    assert forms == {"ball": "body", "net": "cords", "floor": "static"}
+    # the ball, the net, the floor and the hoop's set pieces (rim, backboard, pole)
+    assert {"ball": "body", "net": "cords", "floor": "static", "rim": "static",
+            "backboard": "static", "hoop-pole": "static"}.items() <= forms.items()
     forms = {s.name: s.form for s in from_result(cloth_result).shapes}
     assert forms == {"cloth": "surface", "floor": "static"}
 
@@ -67,7 +69,8 @@ def test_usd_round_trip_matches_frames(ball_result, tmp_path):
     curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/net"))
     assert curves.GetTypeAttr().Get() == UsdGeom.Tokens.linear
     assert curves.GetWidthsAttr().Get()[0] > 0
-    seg = run.shape("net").segments.reshape(-1)
+    from interplay.outputs.geometry import chains
+    seg = np.concatenate(chains(run.shape("net").segments, run.frames["net"]["points"][0]))
     fr = ball_result.frames
     for i in (0, nf // 2, nf - 1):
         m = np.array(ball.ComputeLocalToWorldTransform(i)).T  # USD matrices are row-vector
@@ -76,8 +79,9 @@ def test_usd_round_trip_matches_frames(ball_result, tmp_path):
         np.testing.assert_allclose(m[:3, :3], quat_matrix(q), atol=1e-9)
         pts = np.array(curves.GetPointsAttr().Get(i))
         np.testing.assert_allclose(pts, fr["net"]["points"][i][seg], rtol=0, atol=1e-6)
-    colour = UsdGeom.Gprim(stage.GetPrimAtPath("/World/ball/mesh")).GetDisplayColorAttr().Get()
-    assert len(colour) == 1
+    # the ball's seams: a colour per vertex
+    colour = UsdGeom.Gprim(stage.GetPrimAtPath("/World/ball/geom")).GetDisplayColorAttr().Get()
+    assert len(colour) == len(run.shape("ball").verts)
 
 
 def test_usd_mesh_of_a_deforming_surface(cloth_result, tmp_path):
@@ -179,7 +183,8 @@ def synthetic_run():
     spray = np.full((nf, 4, 3), np.nan)
     for i in range(nf):
         spray[i, :i] = [0.5, 0.0, 0.2 * i]  # i particles at frame i
-    shapes = [Shape("figure", "parts", (0.3, 0.6, 0.8), parts=[(v * 0.1, t), (v * 0.2, t)]),
+    shapes = [Shape("figure", "parts", (0.3, 0.6, 0.8), parts=[(v * 0.1, t), (v * 0.2, t)],
+                    part_names=("pelvis", "torso"), part_parents=(-1, 0)),
               Shape("spray", "particles", (0.3, 0.6, 0.9), width=0.01)]
     frames = {"figure": {"t": times, "segment_positions": seg_pos,
                          "segment_orientations": seg_q},
@@ -194,7 +199,7 @@ def test_figures_and_spray_export(tmp_path):
     path = write_usd(run, tmp_path / "s.usdc")
     assert validate(path) == []
     stage = Usd.Stage.Open(str(path))
-    seg1 = UsdGeom.Xformable(stage.GetPrimAtPath("/World/figure/seg_01"))
+    seg1 = UsdGeom.Xformable(stage.GetPrimAtPath("/World/figure/pelvis/torso"))
     np.testing.assert_allclose(np.array(seg1.ComputeLocalToWorldTransform(3)).T[:3, 3],
                                [0.0, 0.0, 1.8], atol=1e-12)
     pts = UsdGeom.Points(stage.GetPrimAtPath("/World/spray")).GetPointsAttr()
@@ -217,5 +222,5 @@ def test_figures_and_spray_render(tmp_path):
         pytest.skip(str(e))
     with r:
         img = r.render(synthetic_run(), 0.3)
-    assert img.std() > 5  # figure, spray and the ground added under a floorless scene
-    assert [s.name for s in r.shapes][-1] == "ground"
+    assert img.std() > 5  # figure and spray in front of the backdrop
+    assert [s.name for s in r.shapes] == ["figure", "spray"]  # no floor invented

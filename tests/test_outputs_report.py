@@ -51,7 +51,7 @@ def printed_paths(out: str) -> list[Path]:
 
 def test_run_writes_every_output_and_report(tmp_path, capsys):
     code, out, err = run_cli(capsys, "run", "basketball", "--coupling", "hybrid",
-                             "--duration", "0.35", "--out", str(tmp_path), *SMALL)
+                             "--duration", "0.35", "--out", str(tmp_path), "--obj", *SMALL)
     assert code == 0, err
     paths = printed_paths(out)
     for name in ("summary.json", "tracks.npz", "scene.json", "run.usdc", "obj",
@@ -69,6 +69,19 @@ def test_run_writes_every_output_and_report(tmp_path, capsys):
     assert "stand-in" in text and "Primary debug-cycle time" in text
     assert "<style>" in text and "stylesheet" not in text  # self-contained CSS
     assert not list(tmp_path.rglob("*.part"))
+    # every file readable by all, as any file the user writes (mkstemp alone gives 0600)
+    import os
+    mask = os.umask(0o022)
+    os.umask(mask)
+    modes = {p.name: p.stat().st_mode & 0o777 for p in tmp_path.rglob("*") if p.is_file()}
+    assert set(modes.values()) == {0o666 & ~mask}, modes
+
+
+def test_obj_is_opt_in(tmp_path, capsys):
+    code, out, err = run_cli(capsys, "run", "basketball", "--duration", "0.1", "--out",
+                             str(tmp_path), "--no-video", "--no-report", "--quiet")
+    assert code == 0, err
+    assert (tmp_path / "run.usdc").exists() and not (tmp_path / "obj").exists()
 
 
 def test_compare_writes_side_by_side_video_and_report(tmp_path, capsys):
@@ -104,7 +117,7 @@ def test_no_video_report_says_so(tmp_path, capsys):
     (["--camera", "0,0,1:0,0,1"], "same point"),
     (["--size", "big"], "--size big: expected WIDTHxHEIGHT"),
     (["--size", "321x200"], "must be even"),
-    (["--video-fps", "0"], "--video-fps 0: choose 1 to 240"),
+    (["--video-fps", "0"], "--video-fps 0: out of range; --video-fps must be a finite number >= 1 and <= 240"),
 ])
 def test_bad_output_options_fail_in_one_line(tmp_path, capsys, args, words):
     code, out, err = run_cli(capsys, "run", "basketball", "--out", str(tmp_path), *args)
@@ -130,11 +143,12 @@ def test_view_of_a_directory_without_a_run(tmp_path, capsys):
 
 def test_missing_gl_driver_fails_before_simulating(tmp_path, capsys, monkeypatch):
     moderngl = pytest.importorskip("moderngl")
-    from interplay.outputs.render import gl
+    from interplay.outputs.render import gl, worker
 
     def no_egl(**kw):
         raise Exception("libEGL.so.1: cannot open shared object file")
     monkeypatch.setattr(gl, "_CTX", None)
+    monkeypatch.setattr(worker, "_WORKER", None)  # a fresh renderer process makes the check
     monkeypatch.setattr(moderngl, "create_context", no_egl)
     code, out, err = run_cli(capsys, "run", "basketball", "--out", str(tmp_path))
     assert code == 2 and err.count("\n") == 1

@@ -37,10 +37,19 @@ def test_keys_lists_every_leaf():
     ("inner.x", "1", "unknown parameter; valid keys: inner.k"),
     ("inner", "1", "is a group"),
     ("n.m", "1", "unknown parameter"),
-    ("n", "1.5", "expected a int value"),
-    ("inner.on", "maybe", "expected a bool value"),
-    ("dt", "soon", "expected a float value"),
+    ("n", "1.5", "not a whole number; n must be a whole number"),
+    ("inner.on", "maybe", "inner.on=maybe: not true or false"),
+    ("dt", "soon", "dt=soon: .soon. is not a number; dt must be a finite number"),
 ])
 def test_bad_overrides_say_what_is_wrong(key, value, message):
     with pytest.raises(ParameterError, match=message):
         P.apply(Outer(), {key: value})
+
+
+def test_a_field_of_another_type_is_kept_but_not_settable():
+    @dataclass(frozen=True)
+    class WithList:
+        names: list = field(default_factory=list)
+    assert P.table(WithList())[0][3] == "set in Python only"
+    with pytest.raises(ParameterError, match="cannot be set from the command line"):
+        P.apply(WithList(), {"names": "a,b"})

@@ -127,7 +127,7 @@ def test_viscous_drag_field_acts_on_the_submerged_part_only():
                   position=(0, 0, 0.5), velocity=(0, 0, -1.0))
     vol = 4.0 / 3.0 * math.pi * 0.1 ** 3
     field = ViscousDragField(ViscousDragFieldParams(surface=0.0, linear=2.0, quadratic=0.0,
-                                                    density=1000.0), 0.1, vol)
+                                                    density=1000.0))
     f, _, active = field.act(ball)
     assert not active and not f.any()
     ball.x[2] = 0.0  # half under: f = 1/2

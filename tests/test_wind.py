@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from interplay.errors import ParameterError
-from interplay.systems.path import Path, PathFollower
+from interplay.systems.path import Path, PathFollower, Prop
 from interplay.systems.wind import FlowPrimitive, WindField
 
 RNG = np.random.default_rng(4)
@@ -81,9 +81,10 @@ def test_drift_gust_and_path():
     kind, centre, axis, strength, core = field(ride).arrays(1.0)
     assert np.allclose(centre[0], path.position(1.0) + [0, -0.5, 0.3])
     assert np.allclose(axis[0], [0, 1, 0])
-    bike = PathFollower("bike", path, [[1.0, 0, 0], [0, 0, 0], [0, 0, 1]], [[0, 1, 2]])
+    bike = PathFollower("bike", path, Prop([[1.0, 0, 0], [0, 0, 0], [0, 0, 1]], [[0, 1, 2]]))
     bike.advance(1.0)
-    assert np.allclose(bike.points()[0], path.position(1.0) + [0, 1, 0])
+    pos, rot = bike.world_parts()
+    assert np.allclose(rot[0] @ [1.0, 0, 0] + pos[0], path.position(1.0) + [0, 1, 0])
     assert np.allclose(bike.generalized_state()[1][:3], path.velocity(1.0))
 
 

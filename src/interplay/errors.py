@@ -21,6 +21,14 @@ class StabilityError(InterplayError):
     """A setting is known to be unstable (a step above the explicit bound) or a run blew up."""
 
 
+class CostError(InterplayError):
+    """A run would need more memory or steps than the budget; ``--force`` goes on anyway."""
+
+
+class OutputError(InterplayError):
+    """A saved run or checkpoint is missing, damaged, of another run, or cannot be written."""
+
+
 def require_positive(owner: str, name: str, value, unit: str = "") -> float:
     """Return ``value`` as float, or raise ParameterError if it is not finite and > 0."""
     try:

@@ -8,6 +8,7 @@ compare tables and the outputs read was copied out of the scene when the run end
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 
@@ -105,7 +106,23 @@ class Result:
     def interaction_stats(self) -> list[dict]:
         return [interaction_stats(self.logs[it["name"]]) for it in self.interactions]
 
-    def advice(self, one_way_stable=None, two_way_cost_s=None) -> dict:
+    @property
+    def work(self) -> float:
+        """State values advanced over the run (substeps x values, every pass): its cost as a
+        count, the same on any machine."""
+        return float(sum(p.get("work", 0.0) for p in self.passes))
+
+    def advice(self, one_way_stable=None, two_way_work=None, two_way_wall_s=None) -> dict:
+        """The advisor's verdict for the scene's main interaction; the verdict depends on
+        counts only; the wall time of the two-way run is reported beside it."""
+        out = self._advice(one_way_stable, two_way_work)
+        if two_way_wall_s is None and self.coupling == "two-way":
+            two_way_wall_s = self.total_s
+        if two_way_wall_s is not None:
+            out["two_way_wall_s"] = float(two_way_wall_s)
+        return out
+
+    def _advice(self, one_way_stable, two_way_cost_s) -> dict:
         """The advisor's verdict for the scene's main interaction."""
         it = self.main_interaction
         if it is None:
@@ -113,7 +130,7 @@ class Result:
         if one_way_stable is None and it["mode"] != "two-way":
             one_way_stable = not any(it["secondary"] in w for w in self.warnings)
         if two_way_cost_s is None and it["mode"] == "two-way":
-            two_way_cost_s = self.total_s
+            two_way_cost_s = self.work
         return advise(interaction_stats(self.logs[it["name"]]), it, one_way_stable,
                       two_way_cost_s)
 
@@ -125,15 +142,19 @@ class Result:
                 "warnings": list(self.warnings)}
 
     # --- files -----------------------------------------------------------------------------
-    def save(self, out_dir, summary: dict | None = None) -> list:
-        """Write summary.json and tracks.npz into out_dir (atomically). Returns the paths."""
+    def save(self, out_dir, summary: dict | None = None, run_id: str | None = None) -> list:
+        """Write summary.json (strict JSON: a non-finite number is written as null) and
+        tracks.npz into out_dir (atomically); both carry ``run_id`` when given. Returns the
+        paths."""
         from pathlib import Path
         out = Path(out_dir)
         summary = summary if summary is not None else self.summary()
+        if run_id is not None:
+            summary = dict(summary, run_id=run_id)
         paths = [out / "summary.json", out / "tracks.npz"]
         with atomic_path(paths[0]) as tmp:
-            tmp.write_text(json.dumps(summary, indent=2, default=_json_default))
-        arrays = {}
+            tmp.write_text(strict_json(summary, indent=2))
+        arrays = {} if run_id is None else {"run_id": np.array(run_id)}
         for name, fr in self.frames.items():
             for key, arr in fr.items():
                 arrays[f"{name}/{key}"] = arr
@@ -173,3 +194,22 @@ def _json_default(o):
     if isinstance(o, np.ndarray):
         return o.tolist()
     raise TypeError(type(o).__name__)
+
+
+def _finite(o):
+    """``o`` with every non-finite float replaced by None (JSON has no NaN or inf)."""
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    if isinstance(o, dict):
+        return {k: _finite(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_finite(v) for v in o]
+    if isinstance(o, (np.generic, np.ndarray)):
+        return _finite(_json_default(o))
+    return o
+
+
+def strict_json(doc, **kw) -> str:
+    """``doc`` as strict JSON (RFC 8259): NaN and inf, which no JSON parser must accept,
+    become null; anything else unknown is an error."""
+    return json.dumps(_finite(doc), allow_nan=False, default=_json_default, **kw)

@@ -5,7 +5,7 @@ import time as wallclock
 
 from .coupling.forcelog import ForceLog
 from .coupling.modes import MODES
-from .coupling.scheduler import as_array_frames, plan, run_passes
+from .coupling.scheduler import as_array_frames, plan
 from .errors import SceneError, require_positive
 from .systems.base import Role
 
@@ -82,23 +82,34 @@ class Scene:
                 return it
         return moving[0] if moving else None
 
-    def simulate(self, progress=None, refine_unstable: bool = True, primary_only: bool = False):
+    def simulate(self, progress=None, refine_unstable: bool = True, primary_only: bool = False,
+                 force: bool = False, checkpointer=None, resume=None):
         """Run all passes and return a Result (tracks, force logs, timings, diagnostics, the
         systems' shapes: data only, no live object).
 
         primary_only: stop after the pass that contains the primary (the animator's fast
-        preview of the primary under one-way or hybrid coupling)."""
+        preview of the primary under one-way or hybrid coupling). The run's cost is estimated
+        first and refused over the scheduler's BUDGET (CostError) unless ``force``.
+        checkpointer: a coupling.checkpoint.Checkpointer saving the run as it goes; resume:
+        (header, arrays) of a checkpoint of this same scene to continue from."""
+        from .coupling.scheduler import Runner, check_budget, estimate
         from .result import Result
         t0 = wallclock.perf_counter()
         passes = plan(self.systems, self.interactions)
         if primary_only and self.primary is not None:
             keep = next(i for i, p in enumerate(passes) if self.primary in p.live)
             passes = passes[: keep + 1]
+        check_budget(estimate(passes, self.duration, self.fps, self.coupling_dt), self.name,
+                     force)
         logs = {it.name: ForceLog(it.name, it.primary.name, it.secondary.name, it.mode,
                                   it.primary.mass) for it in self.interactions}
-        initial_ke = {s.name: s.kinetic_energy() for s in self.systems}
-        tracks, frames, warnings, monitors = run_passes(
-            passes, self.duration, self.fps, self.coupling_dt, logs, progress, refine_unstable)
+        runner = Runner(self.systems, self.interactions, passes, self.duration, self.fps,
+                        self.coupling_dt, logs, progress, refine_unstable,
+                        checkpointer=checkpointer)
+        runner.extra["initial_ke"] = {s.name: s.kinetic_energy() for s in self.systems}
+        if resume is not None:
+            runner.restore(*resume)
+        tracks, frames, warnings, monitors = runner.run()
         total = wallclock.perf_counter() - t0
         return Result.of(self, passes, logs, tracks, as_array_frames(frames), warnings,
-                         monitors, initial_ke, total)
+                         monitors, runner.extra["initial_ke"], total)

@@ -9,7 +9,15 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import InterplayError, ParameterError
+from dataclasses import dataclass
+
+from .. import params as P
+from ..errors import CostError, InterplayError, ParameterError, StabilityError
+from ..params import param
+
+
+#: the smallest preview the captions fit in (the overlay's text is ~130 px wide, 34 px high)
+MIN_SIZE = (160, 90)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -18,19 +26,61 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+@dataclass(frozen=True)
+class RunOptions:
+    """The command line's numeric options, declared like scene parameters (params.param):
+    parsed, bounded and explained by the same domains."""
+    duration: float | None = param(None, "s", ge=1e-6, le=1e6, doc="simulated time")
+    fps: float | None = param(None, "frames/s", ge=0.01, le=10_000.0)
+    dt: float | None = param(None, "s", ge=1e-12, le=1.0, doc="spring-mass step")
+    video_fps: float = param(24.0, "frames/s", ge=1.0, le=240.0)
+    checkpoint_every: float | None = param(None, "s", gt=0.0, le=1e6,
+                                           doc="simulated seconds between checkpoints")
+    checkpoint_minutes: float = param(5.0, "min", ge=0.0, le=1e4,
+                                      doc="wall minutes between checkpoints (0: never)")
+
+
+def _options(args) -> RunOptions:
+    """RunOptions from the parsed command line (strings), each checked by its domain."""
+    opts = RunOptions()
+    for key in ("duration", "fps", "dt", "video_fps", "checkpoint_every", "checkpoint_minutes"):
+        text = getattr(args, key, None)
+        if text is not None:
+            try:
+                opts = P.override(opts, key, text)
+            except ParameterError as e:  # named as on the command line: --video-fps
+                flag = "--" + key.replace("_", "-")
+                raise ParameterError(str(e).replace(f"{key}=", f"{flag} ", 1)
+                                     .replace(f"; {key} must", f"; {flag} must", 1)) from None
+    return opts
+
+
 def _scene_options(p):
     p.add_argument("scene", help="scene name (see `interplay list`)")
-    p.add_argument("--duration", type=float, default=None,
-                   help="simulated seconds (default: the scene's)")
-    p.add_argument("--fps", type=float, default=None,
+    p.add_argument("--duration", default=None, help="simulated seconds (default: the scene's)")
+    p.add_argument("--fps", default=None,
                    help="output frames per second (default: the scene's)")
     p.add_argument("--integrator", default=None,
                    help="explicit | implicit | localglobal (spring-mass systems)")
-    p.add_argument("--dt", type=float, default=None, help="spring-mass step in seconds")
+    p.add_argument("--dt", default=None, help="spring-mass step in seconds")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter, e.g. --set net.cord_ea=300")
     p.add_argument("--out", default=None, help="output directory (default out/SCENE)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.add_argument("--force", action="store_true",
+                   help="run even when the estimated memory or steps exceed the budget")
+    p.add_argument("--help-params", nargs="?", const="table", choices=("table", "json"),
+                   help="print every --set key with unit, default and range (json: the JSON "
+                        "schema) and exit")
+
+
+def _resume_options(p):
+    p.add_argument("--resume", action="store_true",
+                   help="continue the interrupted run whose checkpoint is in --out")
+    p.add_argument("--checkpoint-every", default=None, metavar="SECONDS",
+                   help="save a checkpoint every SECONDS of simulated time")
+    p.add_argument("--checkpoint-minutes", default=None, metavar="MIN",
+                   help="save a checkpoint every MIN minutes of wall time (default 5; 0: never)")
 
 
 def _output_options(p):
@@ -38,9 +88,13 @@ def _output_options(p):
     g.add_argument("--camera", default=None, metavar="EYE:TARGET[:FOV]",
                    help='preview camera "eye_x,eye_y,eye_z:target_x,target_y,target_z[:fov_deg]"'
                         " in m and degrees (default: frame every system)")
-    g.add_argument("--size", default="1280x720", metavar="WxH", help="video size in pixels")
-    g.add_argument("--video-fps", type=float, default=30.0, help="video frames per second")
+    g.add_argument("--size", default="960x540", metavar="WxH",
+                   help="video size in pixels (default 960x540; 1280x720 costs twice as much)")
+    g.add_argument("--video-fps", default=None,
+                   help="video frames per second (default 24, animation's rate)")
     g.add_argument("--usda", action="store_true", help="write text .usda instead of .usdc")
+    g.add_argument("--obj", action="store_true",
+                   help="also write OBJ sequences (a file per frame per system; off by default)")
     for name in ("usd", "obj", "video", "report"):
         g.add_argument(f"--no-{name}", action="store_true", help=f"skip the {name} output")
 
@@ -54,12 +108,17 @@ def _outputs(args, spec=None):
     if not x or not w.isdigit() or not h.isdigit():
         raise ParameterError(f"--size {args.size}: expected WIDTHxHEIGHT in pixels, e.g. 1280x720")
     from ..outputs.render.video import check_size
+    if len(w) > 6 or len(h) > 6:
+        raise ParameterError(f"--size {args.size}: at most 999999 pixels a side")
+    if (not args.no_video or not args.no_report) and (int(w) < MIN_SIZE[0]
+                                                      or int(h) < MIN_SIZE[1]):
+        raise ParameterError(f"--size {args.size}: the preview and its captions need at least "
+                             f"{MIN_SIZE[0]}x{MIN_SIZE[1]} pixels")
     size = check_size((int(w), int(h)))
-    if not 1.0 <= args.video_fps <= 240.0:
-        raise ParameterError(f"--video-fps {args.video_fps:g}: choose 1 to 240 frames/s")
     return OutputOptions(usd=not args.no_usd, usd_format="usda" if args.usda else "usdc",
-                         obj=not args.no_obj, video=not args.no_video, report=not args.no_report,
-                         size=size, video_fps=args.video_fps,
+                         obj=args.obj and not args.no_obj, video=not args.no_video,
+                         report=not args.no_report,
+                         size=size, video_fps=_options(args).video_fps,
                          camera=(parse_camera(args.camera) if args.camera
                                  else spec.camera if spec is not None else None),
                          quiet=args.quiet)
@@ -75,6 +134,7 @@ def _parser():
                      help="two-way | one-way | hybrid (default: the scene's own)")
     run.add_argument("--controller", default=None, metavar="FILE",
                      help="controller parameters from `interplay tune` (controller.json)")
+    _resume_options(run)
     _output_options(run)
     cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
     _scene_options(cmp_)
@@ -92,34 +152,75 @@ def _parser():
 
 def _build_kwargs(args):
     """(the scene's SceneSpec, the build keywords) from the command line, every value checked
-    against the spec before anything runs."""
-    from .. import params as P
+    against the spec and the parameters' domains (defaults too) before anything runs, and the
+    parameters' element counts against the budget (CostError unless --force)."""
     from ..scenes import spec as scene_spec
     spec = scene_spec(args.scene)
     assignments = {}
     for item in args.sets:
         key, eq, value = item.partition("=")
-        if not eq or not key:
-            raise ParameterError(f"--set {item}: expected KEY=VALUE")
+        if not eq or not key.strip():
+            raise ParameterError(f"--set {item[:80]}: expected KEY=VALUE")
         assignments[key.strip()] = value.strip()
     if getattr(args, "controller", None):  # a tuned controller; --set still overrides it
         from .tune import controller_sets
         assignments = {**controller_sets(spec, args.controller), **assignments}
-    kw = {"params": P.apply(spec.params(), assignments), "fps": args.fps or spec.fps,
-          "duration": args.duration if args.duration is not None else spec.duration}
+    try:
+        params = P.apply(spec.params(), assignments)
+    except ParameterError as e:
+        raise ParameterError(f"--set {e}") from None
+    # a default's own check (the puddle's clip, where no mocap folder is) warns: the scene
+    # has its fallback; what the user set is checked strictly above
+    notes = P.validate(params, trusted=set(P.keys(params)) - set(assignments))
+    args.notes = [f"{spec.name}: {n}" for n in notes]
+    if getattr(args, "help_params", None) is None:
+        P.check_cost(params, spec.name, args.force, default=spec.params())
+    opts = _options(args)
+    kw = {"params": params, "fps": opts.fps or spec.fps,
+          "duration": opts.duration if opts.duration is not None else spec.duration}
     integrator = spec.check_integrator(args.integrator)
     if integrator is not None:
         kw["integrator"] = integrator
-    if args.dt is not None:
-        kw["dt"] = args.dt
+    if opts.dt is not None:
+        kw["dt"] = opts.dt
     return spec, kw
 
 
-def run_scene(spec, mode, kw, quiet=True):
-    """Build and simulate one scene in one coupling mode (checked against its spec)."""
+def build_scene(spec, mode, kw):
+    """The scene, built; a MemoryError while allocating is one line with what to lower."""
+    try:
+        return spec.build(spec.check_coupling(mode), **kw)
+    except MemoryError:
+        raise CostError(f"{spec.name}: out of memory while building the scene; lower the "
+                        "parameters that set element counts (see --help-params, the x-cost "
+                        "column)") from None
+
+
+def run_scene(spec, mode, kw, quiet=True, force=False, checkpointer=None, resume=None,
+              given: str = ""):
+    """Build and simulate one scene in one coupling mode (checked against its spec).
+    given: what the command line set ("--dt 1e-9, --set net.loops=40"), named in front of
+    an error the build or the run raises (a stability bound, a cost), since it is the cause."""
     from .progress import PassProgress
-    scene = spec.build(spec.check_coupling(mode), **kw)
-    return scene.simulate(progress=PassProgress(scene.duration, quiet))
+    try:
+        scene = build_scene(spec, mode, kw)
+        try:
+            return scene.simulate(progress=PassProgress(scene.duration, quiet), force=force,
+                                  checkpointer=checkpointer, resume=resume)
+        except MemoryError:
+            raise CostError(f"{spec.name}: out of memory while simulating; shorten "
+                            "--duration, lower --fps, or lower the element counts") from None
+    except InterplayError as e:
+        if given:
+            raise type(e)(f"with {given}: {e}") from None
+        raise
+
+
+def _given(args) -> str:
+    """The options and --set assignments the command line gave, as typed."""
+    out = [f"--{k} {getattr(args, k)}" for k in ("duration", "fps", "dt", "integrator")
+           if getattr(args, k, None) is not None]
+    return ", ".join(out + [f"--set {s}" for s in args.sets])
 
 
 def scene_summary(spec, result, **advice_kw) -> dict:
@@ -136,15 +237,69 @@ def cmd_list(args, console):
         console.print(f"[bold]{spec.name}[/bold]  {spec.description}")
 
 
+def _request(args) -> dict:
+    """What a run was asked for: its checkpoint and manifest keep it, --resume repeats it."""
+    return {"scene": args.scene, "coupling": args.coupling, "sets": list(args.sets),
+            "duration": args.duration, "fps": args.fps, "dt": args.dt,
+            "integrator": args.integrator, "force": bool(args.force)}
+
+
+def _help_params(args, console) -> bool:
+    if args.help_params is None:
+        return False
+    from ..scenes import spec as scene_spec
+    spec = scene_spec(args.scene)
+    if args.help_params == "json":
+        print(json.dumps(P.json_schema(spec.params(), f"{spec.name} parameters"), indent=1))
+        return True
+    from rich.table import Table
+    t = Table(title=f"{spec.name}: --set KEY=VALUE")
+    for col in ("key", "unit", "default", "accepts", ""):
+        t.add_column(col)
+    for row in P.table(spec.params()):
+        t.add_row(*row)
+    console.print(t)
+    return True
+
+
 def cmd_run(args, console):
+    if _help_params(args, console):
+        return
+    out = Path(args.out or f"out/{args.scene}")
+    from ..coupling import checkpoint as C
+    resume = None
+    if args.resume:
+        header, arrays = C.read(out / C.FILE)
+        req = header["request"]
+        if req.get("scene") != args.scene:
+            raise ParameterError(f"--resume: the checkpoint in {out} is of scene "
+                                 f"{req.get('scene')}, not {args.scene}")
+        for key in ("coupling", "sets", "duration", "fps", "dt", "integrator", "force"):
+            setattr(args, key, req.get(key))
+        resume = (header, arrays)
     spec, kw = _build_kwargs(args)
     mode = spec.check_coupling(args.coupling)
-    out = Path(args.out or f"out/{args.scene}")
     options = _outputs(args, spec)
+    from ..outputs.runfolder import new_run_id
     from ..outputs.writer import preflight, write_outputs
+    from ..outputs.runfolder import Lock, claim
     preflight(out, options)
-    result = run_scene(spec, mode, kw, args.quiet)
-    paths = write_outputs(result, out, options, scene_summary(spec, result))
+    opts = _options(args)
+    run_id = resume[0]["request"].get("run_id") if resume else new_run_id()
+    ckpt = C.Checkpointer(out / C.FILE, dict(_request(args), run_id=run_id),
+                          opts.checkpoint_every, 60.0 * opts.checkpoint_minutes or None)
+    with Lock(out):
+        claim(out)
+        try:
+            result = run_scene(spec, mode, kw, args.quiet, args.force, ckpt, resume,
+                               _given(args))
+        except StabilityError:  # resuming would only repeat it
+            (out / C.FILE).unlink(missing_ok=True)
+            raise
+        result.warnings[:0] = args.notes
+        paths = write_outputs(result, out, options, scene_summary(spec, result), run_id,
+                              _request(args), locked=True)
+        (out / C.FILE).unlink(missing_ok=True)
     from .text import print_run
     print_run(console, result)
     for p in paths:
@@ -197,18 +352,79 @@ COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-stand
             "tune": cmd_tune, "view": cmd_view}
 
 
+def _argv(argv):
+    """Join an option and a value that starts with '-' (``--camera -2,-6,2:0,0,1``), which
+    argparse would take for another option."""
+    out, it = [], iter(argv)
+    for a in it:
+        if a in ("--camera", "--set", "--size") :
+            nxt = next(it, None)
+            if nxt is not None and nxt.startswith("-") and not nxt.startswith("--"):
+                out.append(f"{a}={nxt}")
+                continue
+            out.append(a)
+            if nxt is not None:
+                out.append(nxt)
+        else:
+            out.append(a)
+    return out
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled like Ctrl-C: temporaries are removed, the checkpoint stays."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
+#: MuJoCo's warnings of this process (quiet_mujoco), newest last
+MUJOCO_WARNINGS: list = []
+
+
+def quiet_mujoco():
+    """MuJoCo writes MUJOCO_LOG.TXT into the working directory on a warning; nothing is
+    written outside --out, so its warnings are kept in MUJOCO_WARNINGS instead (the one it
+    gives for an unstable figure, NaN in its state, is the figure's health() report too)."""
+    try:
+        import mujoco
+    except ImportError:
+        return
+    mujoco.set_mju_user_warning(lambda msg: MUJOCO_WARNINGS.append(msg.strip()))
+
+
 def main(argv=None) -> int:
+    import os
+    import signal
     from rich.console import Console
-    args = _parser().parse_args(argv)
+    args = _parser().parse_args(_argv(sys.argv[1:] if argv is None else list(argv)))
     console = Console()
+    previous = signal.getsignal(signal.SIGTERM)
+    try:
+        signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:  # not the main thread
+        previous = None
+    quiet_mujoco()
     try:
         COMMANDS[args.command](args, console)
     except InterplayError as e:
         print(f"interplay: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("interplay: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as e:
+        how = "terminated" if isinstance(e, Terminated) else "interrupted"
+        print(f"interplay: {how}; `interplay run ... --resume` continues from the last "
+              "checkpoint", file=sys.stderr)
+        return 143 if isinstance(e, Terminated) else 130
+    except Exception as e:  # noqa: BLE001 - a bug, not the user's input: one line, exit 3
+        if os.environ.get("INTERPLAY_DEBUG"):
+            raise
+        print(f"interplay: internal error (a bug, not your input): {type(e).__name__}: "
+              f"{str(e).splitlines()[0][:200] if str(e) else ''}; rerun with INTERPLAY_DEBUG=1 "
+              "for the traceback", file=sys.stderr)
+        return 3
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

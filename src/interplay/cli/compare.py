@@ -25,11 +25,12 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
         results[mode] = run_scene(spec, mode, kw, quiet)
     reference = results.get("two-way")
     one_way_stable = (not any(results["one-way"].warnings)) if "one-way" in results else None
-    two_way_cost = reference.total_s if reference is not None else None
+    two_way_cost = reference.work if reference is not None else None
+    wall = reference.total_s if reference is not None else None
     rows, paths = {}, []
     for mode, r in results.items():
         summary = scene_summary(spec, r, one_way_stable=one_way_stable,
-                                two_way_cost_s=two_way_cost)
+                                two_way_work=two_way_cost, two_way_wall_s=wall)
         if options is None:
             paths += r.save(out / mode, summary)
         else:
@@ -37,7 +38,8 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
             paths += write_outputs(r, out / mode, options, summary)
         rows[mode] = mode_row(r, summary.get("figures", {}))
     first = reference or next(iter(results.values()))
-    advice = first.advice(one_way_stable=one_way_stable, two_way_cost_s=two_way_cost)
+    advice = first.advice(one_way_stable=one_way_stable, two_way_work=two_way_cost,
+                          two_way_wall_s=wall)
     report = {"scene": spec.name, "modes": rows, "advice": advice}
     path = out / "compare.json"
     with atomic_path(path) as tmp:
@@ -53,9 +55,15 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
 
 
 def _figure(value) -> str:
+    """A key figure as table text: numbers to 3 places, lists item by item (a scene's
+    figures may also hold counts, names, nested lists and None for "not measured")."""
+    if value is None:
+        return "-"
     if isinstance(value, (list, tuple)):
-        return ", ".join(f"{v:.2f}" for v in value)
-    return f"{value:.3f}"
+        return ", ".join(f"{v:.2f}" if isinstance(v, float) else _figure(v) for v in value)
+    if isinstance(value, float):
+        return f"{value:.3f}"
+    return str(value)
 
 
 def _print_table(console, rows, advice):

@@ -83,8 +83,9 @@ class Viewer:
             self.handles.append(("pose", shape.name, h))
         elif shape.form == "parts":
             for k, (v, t) in enumerate(shape.parts):
-                h = sc.add_mesh_simple(f"{name}/seg_{k:02d}", v.astype(np.float32),
-                                       t.astype(np.uint32), color=color)
+                part = color if shape.part_colors is None else _rgb(shape.part_colors[k])
+                h = sc.add_mesh_simple(f"{name}/{shape.part_names[k]}", v.astype(np.float32),
+                                       t.astype(np.uint32), color=part)
                 self.handles.append(("part", (shape.name, k), h))
         elif shape.form == "surface":
             h = sc.add_mesh_simple(name, fr["points"][0].astype(np.float32),

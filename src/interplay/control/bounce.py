@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..geometry.anthropometry import SEGMENTS
+from ..params import param
 from .fsm import Controller, State, Transition
 
 SLEW = 4.0  # rad/s: the balance offsets' fastest change
@@ -66,24 +67,24 @@ class BounceParams:
     under the feet a metre below the centre of mass, against the spin; k_arms (-): the share
     of the body's pitch spin the arms take in the air by circling (forward against a
     backward spin), so the trunk lands upright, a trampolinist's correction."""
-    knee_land: float = 0.45
-    lean: float = 0.1
-    trunk: float = 0.0
-    leg_omega: float = 12.0
-    thrust_delay: float = 0.12
-    power: float = 1.0
-    ankle_push: float = 0.2
-    arm_swing: float = 2.8
-    arm_land: float = 0.6
-    k_speed: float = 0.3
-    k_place: float = 0.3
-    k_lead: float = 5.0
-    k_drift: float = 0.3
-    k_spin: float = 0.02
-    k_attitude: float = 0.0
-    k_turn: float = 0.0
-    k_hip_spin: float = 0.0
-    k_arms: float = 0.0
+    knee_land: float = param(0.45, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
+    lean: float = param(0.1, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
+    trunk: float = param(0.0, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
+    leg_omega: float = param(12.0, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
+    thrust_delay: float = param(0.12, "s", ge=0.0, le=2.0, doc="after touchdown")
+    power: float = param(1.0, "-", gt=0.0, le=5.0, doc="the extension's speed")
+    ankle_push: float = param(0.2, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
+    arm_swing: float = param(2.8, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
+    arm_land: float = param(0.6, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
+    k_speed: float = param(0.3, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+    k_place: float = param(0.3, "-", ge=0.0, le=5.0, doc="foot placement on offset")
+    k_lead: float = param(5.0, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.3, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.02, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.0, "-", ge=0.0, le=3.0)
+    k_turn: float = param(0.0, "m s/(kg m^2)", ge=-1.0, le=1.0)
+    k_hip_spin: float = param(0.0, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    k_arms: float = param(0.0, "-", ge=0.0, le=5.0)
 
     def validated(self) -> "BounceParams":
         for f in fields(self):

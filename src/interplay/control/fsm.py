@@ -17,6 +17,10 @@ Events (``Transition.on``), each with its ``value``:
   ``com_below`` / ``com_above``            the centre of mass's height (m) is below / above value
   ``com_ahead``       the centre of mass is more than value (m) ahead of the middle of the feet,
                       along the pelvis's facing direction (a lean far enough to dive)
+  ``pitch_above``     the trunk has turned forward more than value (rad) from upright, about
+                      the figure's starting left-right axis, or will have within the
+                      transition's ``lookahead`` (s) at its present rate (a diver spotting
+                      the water: the faster he turns, the sooner he opens)
 Entry actions: ``hold_pose`` (every target becomes the current angle before the state's pose
 applies), ``neutral`` (every target becomes 0, the rest pose).
 """
@@ -29,16 +33,18 @@ import numpy as np
 from ..errors import ParameterError
 
 EVENTS = ("time", "foot_contact", "no_foot_contact", "hand_contact", "com_falling",
-          "com_rising", "com_below", "com_above", "com_ahead")
+          "com_rising", "com_below", "com_above", "com_ahead", "pitch_above")
 ENTRY_ACTIONS = ("hold_pose", "neutral")
 
 
 @dataclass(frozen=True)
 class Transition:
-    """Go to state ``to`` when event ``on`` happens (with threshold ``value``)."""
+    """Go to state ``to`` when event ``on`` happens (with threshold ``value``; ``lookahead``
+    (s) for pitch_above)."""
     on: str
     to: str
     value: float = 0.0
+    lookahead: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -91,7 +97,7 @@ class _Compiled:
     support: bool
     balance: tuple
     entry: tuple
-    transitions: list  # (event, value, target index)
+    transitions: list  # (event, value, target index, lookahead s)
     blend: float
 
 
@@ -141,7 +147,7 @@ class StateMachine:
                 if t.to not in index:
                     raise ParameterError(f"controller state {s.name!r}: transition to unknown "
                                          f"state {t.to!r}")
-                trans.append((t.on, float(t.value), index[t.to]))
+                trans.append((t.on, float(t.value), index[t.to], float(t.lookahead)))
             self.states.append(_Compiled(
                 s.name, *_pairs(s.pose, names, "pose", s.name),
                 *_pairs(s.velocity, names, "velocity", s.name),
@@ -159,7 +165,7 @@ class StateMachine:
 
     def fired(self, time: float, sensors: dict) -> int | None:
         """The index of the state the first firing transition leads to, or None."""
-        for event, value, target in self.state.transitions:
+        for event, value, target, lookahead in self.state.transitions:
             if event == "time":
                 hit = time - self.entered >= value - 1e-9
             elif event == "foot_contact":
@@ -176,6 +182,8 @@ class StateMachine:
                 hit = sensors["com"][2] < value
             elif event == "com_ahead":
                 hit = sensors["com_ahead"] > value
+            elif event == "pitch_above":
+                hit = sensors["pitch"] + lookahead * sensors["pitch_rate"] > value
             else:  # com_above
                 hit = sensors["com"][2] > value
             if hit:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError, require_positive
+from ..params import param
 
 SEGMENTS = ("pelvis", "torso", "head", "l_upper_arm", "l_forearm", "l_hand", "r_upper_arm",
             "r_forearm", "r_hand", "l_thigh", "l_shank", "l_foot", "l_toes", "r_thigh",
@@ -67,11 +68,12 @@ class BodyParams:
     """A person: total mass (kg) and standing height (m). Optional overrides (m) of the leg
     geometry, used to match a motion-capture subject: thigh, shank, hip_offset (x, y, z of the
     left hip joint from the pelvis origin; the right one mirrors y)."""
-    mass: float = 75.0  # kg
-    height: float = 1.75  # m
-    thigh: float | None = None  # m
-    shank: float | None = None  # m
-    hip_offset: tuple | None = None  # m
+    # a child to a heavy adult: MuJoCo's inertias stay well conditioned over this range
+    mass: float = param(75.0, "kg", ge=10.0, le=500.0)
+    height: float = param(1.75, "m", ge=0.5, le=3.0)
+    thigh: float | None = param(None, "m", gt=0.0, le=2.0)
+    shank: float | None = param(None, "m", gt=0.0, le=2.0)
+    hip_offset: tuple | None = param(None, "m", ge=-1.0, le=1.0, length=3)
 
 
 @dataclass

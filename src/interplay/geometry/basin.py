@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
+from ..params import param
 
 SHAPES = ("ellipse", "rectangle")
 
@@ -17,13 +18,20 @@ class BasinParams:
     along x (the spacing is size_x / cells); depth: still water over the flat bed at z = 0 (m);
     shore: width (m) of the bed's slope up to the rim; rim: height of the bed at the rim as a
     multiple of depth (> 1 leaves a dry beach); shape: ellipse or rectangle."""
-    size_x: float = 2.0  # m
-    size_y: float = 2.0  # m
-    cells: int = 128
-    depth: float = 0.3  # m
-    shore: float = 0.3  # m
-    rim: float = 1.3  # x depth
-    shape: str = "ellipse"
+    size_x: float = param(2.0, "m", ge=0.01, le=1000.0, doc="grid extent along x")
+    size_y: float = param(2.0, "m", ge=0.01, le=1000.0, doc="grid extent along y")
+    # columns along x; along y in proportion: cells^2 size_y / size_x columns in all
+    cells: int = param(128, "columns", ge=4, le=4096, cost=("columns", 2))
+    depth: float = param(0.3, "m", ge=1e-3, le=100.0, doc="still water over the flat bed")
+    shore: float = param(0.3, "m", ge=0.0, le=1000.0, doc="width of the sloping shore")
+    rim: float = param(1.3, "x depth", ge=1.0, le=100.0, doc="bed height at the rim")
+    shape: str = param("ellipse", choices=SHAPES)
+
+    def __post_init__(self):
+        # the column count is cells^2 size_y / size_x: bound the aspect so cells bounds it
+        if not 0.01 <= self.size_y / self.size_x <= 100.0:
+            raise ParameterError(f"size_y / size_x = {self.size_y / self.size_x:.3g} must be "
+                                 "within 0.01 to 100 (a basin, not a channel)")
 
 
 @dataclass(frozen=True)
@@ -73,3 +81,25 @@ def basin(p: BasinParams) -> Basin:
     bed = np.where(fluid, bed, rim)
     d = np.where(fluid, np.maximum(depth - bed, 0.0), 0.0)
     return Basin(bed=bed, fluid=fluid, depth=d, spacing=l, origin=(float(x[0]), float(y[0])))
+
+
+def banks(b: Basin, name: str, size: float, color=(0.30, 0.42, 0.20)):
+    """The ground around a basin (a setpieces.Piece): flat at the height of its rim, out to
+    size (m) from the centre, with a hole where the basin's own bed (over its column centres)
+    is drawn."""
+    from .setpieces import ground_around
+    nx, ny = b.bed.shape
+    lo = np.asarray(b.origin, float)
+    hi = lo + b.spacing * np.array([nx - 1, ny - 1])
+    return ground_around(lo, hi, float(b.bed.max()), size, name, color)
+
+
+def terrain(b: Basin):
+    """height(x, y) -> z (m): the basin's bed (bilinear between column centres) inside its
+    grid, the rim's height (the ground around it) outside."""
+    from scipy.interpolate import RegularGridInterpolator
+    nx, ny = b.bed.shape
+    x = b.origin[0] + b.spacing * np.arange(nx)
+    y = b.origin[1] + b.spacing * np.arange(ny)
+    f = RegularGridInterpolator((x, y), b.bed, bounds_error=False, fill_value=float(b.bed.max()))
+    return lambda px, py: float(f([[px, py]])[0])

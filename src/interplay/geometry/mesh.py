@@ -23,6 +23,10 @@ import numpy as np
 from ..errors import ParameterError, require_positive
 
 MASS_MODES = ("area", "uniform")
+#: the largest mesh file read (bytes) and the most vertices a network is built from
+MAX_FILE_BYTES = 256 * 2 ** 20
+MAX_VERTICES = 2_000_000
+MAX_COORDINATE = 1e6  # m: squared lengths and areas stay far from overflow
 KINDS = ("structural", "shear", "bending")
 
 
@@ -45,6 +49,10 @@ def validate(vertices, triangles, name: str = "mesh") -> tuple[np.ndarray, np.nd
     if len(bad):
         raise ParameterError(f"{name}: vertex {bad[0]} has a non-finite coordinate {x[bad[0]]}; "
                              "fix or remove it")
+    bad = np.flatnonzero(np.abs(x).max(axis=1) > MAX_COORDINATE)
+    if len(bad):
+        raise ParameterError(f"{name}: vertex {bad[0]} at {x[bad[0]]} is more than "
+                             f"{MAX_COORDINATE:g} m from the origin; check the file's units")
     bad = np.flatnonzero(np.any((t < 0) | (t >= len(x)), axis=1))
     if len(bad):
         raise ParameterError(f"{name}: triangle {bad[0]} {t[bad[0]].tolist()} references a vertex "
@@ -90,18 +98,26 @@ def load(path, name: str | None = None) -> tuple[np.ndarray, np.ndarray]:
 
     Vertices are kept exactly as in the file (trimesh's merging is off). Quads and polygons are
     triangulated by trimesh. A scene with several objects is concatenated."""
-    import trimesh
     from pathlib import Path
+
+    import trimesh
+
+    from ..io.inputs import regular_file
     p = Path(path)
     name = name or p.name
-    if not p.is_file():
+    if not p.exists():
         raise ParameterError(f"{name}: mesh file {p} does not exist")
+    regular_file(p, MAX_FILE_BYTES, "mesh file", ParameterError)
     try:
         mesh = trimesh.load(p, force="mesh", process=False)
     except Exception as e:  # trimesh raises many kinds for unreadable files
-        raise ParameterError(f"{name}: cannot read mesh file {p}: {e}") from None
+        msg = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise ParameterError(f"{name}: cannot read mesh file {p}: {msg}") from None
     if not hasattr(mesh, "faces") or len(mesh.faces) == 0:
         raise ParameterError(f"{name}: {p} contains no triangles")
+    if len(mesh.vertices) > MAX_VERTICES:
+        raise ParameterError(f"{name}: {p} has {len(mesh.vertices):,} vertices, over the "
+                             f"{MAX_VERTICES:,} a network may have; decimate it")
     return validate(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces), name)
 
 

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
+from ..params import param
 from ..systems.springmass import SpringNetwork, Springs
 
 
@@ -20,25 +21,28 @@ class NetParams:
     dt: s; integrator: explicit | implicit; cord_radius: m (contact skin); scheme: the implicit
     integrator, bdf2 or theta; theta: for the theta scheme (1 backward Euler, 1/2 trapezoidal).
     """
-    rim_radius: float = 0.2286
-    rim_height: float = 3.05
-    length: float = 0.40
-    bottom_radius: float = 0.11
-    loops: int = 12
-    rows: int = 12  # knot rows below the rim: 6 rows of diamonds
-    mass: float = 0.03
-    cord_ea: float = 300.0
-    rim_stiffness: float = 2.0e3
-    rim_damping: float = 1.0
-    mass_damping: float = 1.0
-    stiffness_damping: float = 2.0e-4
+    rim_radius: float = param(0.2286, "m", ge=0.01, le=5.0)
+    rim_height: float = param(3.05, "m", ge=0.01, le=100.0)
+    length: float = param(0.40, "m", ge=0.01, le=10.0)
+    bottom_radius: float = param(0.11, "m", ge=0.005, le=5.0)
+    loops: int = param(12, "knots", ge=3, le=256, cost="points", doc="knots around the rim")
+    # knot rows below the rim: 6 rows of diamonds
+    rows: int = param(12, "knots", ge=1, le=256, cost="points", doc="knot rows below the rim")
+    mass: float = param(0.03, "kg", ge=1e-5, le=100.0)
+    cord_ea: float = param(300.0, "N", ge=1e-3, le=1e9, doc="cords' stress/strain ratio E A")
+    rim_stiffness: float = param(2.0e3, "N/m", ge=1e-3, le=1e9)
+    # explicit stability of a 2.5 g knot at 1e-5 s needs c < 2 m / dt = 500 N s/m
+    rim_damping: float = param(1.0, "N s/m", ge=0.0, le=100.0)
+    mass_damping: float = param(1.0, "1/s", ge=0.0, le=1e4)
+    stiffness_damping: float = param(2.0e-4, "s", ge=0.0, le=1.0)
     # explicit, the paper's two-way step: with friction 1.0 the ball's path converges at 1e-5 s
     # (2e-5 s is 0.5 mm away, 5e-5 s 2 cm at t = 0.6 s) and the contact goes unstable at 1e-4
-    dt: float = 1e-5
-    integrator: str = "explicit"
-    cord_radius: float = 0.003
-    scheme: str = "theta"  # backward Euler (theta = 1), Baraff & Witkin; or "bdf2"
-    theta: float = 1.0
+    dt: float = param(1e-5, "s", ge=1e-9, le=0.1, doc="the net's largest step")
+    integrator: str = param("explicit", choices=("explicit", "implicit", "localglobal"))
+    cord_radius: float = param(0.003, "m", ge=1e-4, le=0.1, doc="contact skin")
+    # backward Euler (theta = 1), Baraff & Witkin; or "bdf2"
+    scheme: str = param("theta", choices=("theta", "bdf2"), doc="the implicit scheme")
+    theta: float = param(1.0, "-", ge=0.5, le=1.0, doc="1 backward Euler, 1/2 trapezoidal")
 
 
 def net_knots(p: NetParams) -> tuple[np.ndarray, np.ndarray]:

@@ -1,5 +1,6 @@
 """Built-in triangle meshes for spring-mass networks and props: a rectangular cloth grid, a
-disc, a leaf outline with its centre vein, and a simple rider-and-bicycle mesh.
+disc, a leaf outline with its centre vein, and a pole (the bicyclist is a rig of its own:
+geometry/bicycle.py).
 
 Each returns vertices (n,3) in m and triangles (m,3) (int64); the leaf also returns the
 indices of its vein vertices (the stiffer midrib).
@@ -95,38 +96,6 @@ def leaf(length: float, width: float, stations: int = 8, rows: int = 2):
     x[:, :2] = pts
     vein = np.array([0] + [row0(k) + rows for k in range(stations)] + [tip], dtype=np.int64)
     return x, np.array(tris, dtype=np.int64), vein
-
-
-def bicyclist(wheel_radius: float = 0.34, wheelbase: float = 1.05):
-    """A rider on a bicycle, facing +x, wheels touching z = 0, centred between the wheels:
-    two wheels, a frame, the rider's legs, torso, arms and head (boxes, cylinders, a sphere).
-    A prop to look at and to carry the wake; it collides with nothing."""
-    import trimesh
-    from trimesh import creation
-    r, wb = wheel_radius, wheelbase
-
-    def rod(a, b, radius):
-        return creation.cylinder(radius=radius, segment=np.array([a, b], dtype=float), sections=8)
-
-    def wheel(cx):
-        w = creation.annulus(r_min=0.9 * r, r_max=r, height=0.03, sections=24)
-        w.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0]))
-        w.apply_translation([cx, 0.0, r])
-        return w
-
-    hub_b, hub_f = np.array([-wb / 2, 0, r]), np.array([wb / 2, 0, r])
-    seat, bars, crank = (np.array([-0.15, 0, 0.95]), np.array([0.40, 0, 1.0]),
-                         np.array([0.0, 0, 0.32]))
-    shoulder, hip = np.array([0.12, 0, 1.45]), seat + [0, 0, 0.05]
-    parts = [wheel(-wb / 2), wheel(wb / 2),
-             rod(hub_b, crank, 0.02), rod(crank, seat, 0.02), rod(seat, bars, 0.02),
-             rod(bars, hub_f, 0.02), rod(crank, bars - [0.05, 0, 0.1], 0.02),
-             rod(hip, crank + [0.05, 0.12, 0.05], 0.06), rod(hip, crank + [-0.05, -0.12, 0.1], 0.06),
-             rod(hip, shoulder, 0.15), rod(shoulder, bars + [0, 0.2, 0], 0.04),
-             rod(shoulder, bars - [0, 0.2, 0], 0.04),
-             creation.icosphere(subdivisions=2, radius=0.11).apply_translation(shoulder + [0.05, 0, 0.22])]
-    m = trimesh.util.concatenate(parts)
-    return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
 
 
 def pole(height: float, radius: float = 0.025):

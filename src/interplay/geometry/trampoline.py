@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_positive
+from ..params import param
 from . import shapes
 
 
@@ -34,23 +35,23 @@ class BedParams:
     mass_damping (1/s), stiffness_damping (s): Rayleigh; dt (s): the bed's step (explicit:
     below the stability bound the builder reports); thickness (m): half the bed's thickness,
     its contact skin."""
-    length: float = 4.28  # m
-    width: float = 2.14  # m
-    height: float = 1.155  # m
-    nu: int = 37
-    nv: int = 19
-    mass: float = 20.0  # kg
-    spring_mass: float = 0.12  # kg
-    gap: float = 0.30  # m
-    spring_stiffness: float = 250.0  # N/m
-    spring_tension: float = 120.0  # N
-    stretch: float = 1.0e4  # N
-    shear: float = 500.0  # N
-    bend: float = 30.0  # N
-    mass_damping: float = 0.0  # 1/s
-    stiffness_damping: float = 1e-4  # s
-    dt: float = 1.25e-4  # s
-    thickness: float = 0.004  # m
+    length: float = param(4.28, "m", gt=0.0, le=50.0)
+    width: float = param(2.14, "m", gt=0.0, le=50.0)
+    height: float = param(1.155, "m", gt=0.0, le=20.0, doc="the bed's rest plane")
+    nu: int = param(37, "points", ge=3, le=400, cost="points")
+    nv: int = param(19, "points", ge=3, le=400, cost="points")
+    mass: float = param(20.0, "kg", gt=0.0, le=1000.0, doc="bed and springs")
+    spring_mass: float = param(0.12, "kg", ge=0.0, le=10.0, doc="per frame spring")
+    gap: float = param(0.30, "m", gt=0.0, le=5.0, doc="a frame spring's installed length")
+    spring_stiffness: float = param(250.0, "N/m", gt=0.0, le=1e7, doc="per frame spring")
+    spring_tension: float = param(120.0, "N", gt=0.0, le=1e6, doc="per spring, installed")
+    stretch: float = param(1.0e4, "N", gt=0.0, le=1e8, doc="straps' stress/strain")
+    shear: float = param(500.0, "N", gt=0.0, le=1e8)
+    bend: float = param(30.0, "N", gt=0.0, le=1e8)
+    mass_damping: float = param(0.0, "1/s", ge=0.0, le=1e3)
+    stiffness_damping: float = param(1e-4, "s", ge=0.0, le=1.0)
+    dt: float = param(1.25e-4, "s", gt=0.0, le=0.01)
+    thickness: float = param(0.004, "m", gt=0.0, le=0.2, doc="contact skin")
 
     def validated(self) -> "BedParams":
         for name, unit in (("length", "m"), ("width", "m"), ("height", "m"), ("mass", "kg"),

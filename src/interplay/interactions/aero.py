@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative
+from ..params import param
 from ..kernels import aero as K
 from .base import Interaction
 
@@ -21,8 +22,8 @@ class AeroParams:
 
     drag: c_n (kg/m^3), 0.5 rho C_D with C_D ~ 1.2 for a flat plate across the flow;
     friction: c_t (kg/(m^2 s)), linear skin friction along the surface."""
-    drag: float = 0.7
-    friction: float = 0.02
+    drag: float = param(0.7, "kg/m^3", ge=0.0, le=100.0, doc="c_n, 0.5 rho C_D")
+    friction: float = param(0.02, "kg/(m^2 s)", ge=0.0, le=100.0, doc="c_t")
 
 
 class Aerodynamics(Interaction):

@@ -9,14 +9,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
+from ..params import param
 from .base import Interaction
 
 
 @dataclass(frozen=True)
 class AttachmentParams:
     """stiffness (N/m) and damping (N s/m) of each tie."""
-    stiffness: float = 2.0e4
-    damping: float = 100.0
+    stiffness: float = param(2.0e4, "N/m", ge=1e-6, le=1e9, doc="each tie")
+    damping: float = param(100.0, "N s/m", ge=0.0, le=1e7, doc="each tie")
 
 
 class SegmentAttachment(Interaction):

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative
+from ..params import param
 from .base import StandIn
 
 DEPTH_MAX = 1.5  # m: the depressions over which a curve must rise
@@ -37,14 +38,15 @@ class BedSpringsParams:
     deepest point a support point still touches the bed; friction_damping (N s/m) per
     point against sliding, friction (-) its cap over the normal share; enabled: false turns
     the stand-in off (the hybrid primary then falls freely)."""
-    linear: float = 1953.0  # N/m: fitted to BedParams() (docs/trampoline.md)
-    quadratic: float = 4172.0  # N/m^2
-    cubic: float = -260.0  # N/m^3
-    damping: float = 40.0  # N s/m
-    pocket: float = 0.05  # m
-    friction_damping: float = 200.0  # N s/m
-    friction: float = 0.8
-    enabled: bool = True
+    # fitted to BedParams() (docs/trampoline.md)
+    linear: float = param(1953.0, "N/m", ge=0.0, le=1e7)
+    quadratic: float = param(4172.0, "N/m^2", ge=-1e7, le=1e7)
+    cubic: float = param(-260.0, "N/m^3", ge=-1e7, le=1e7)
+    damping: float = param(40.0, "N s/m", ge=0.0, le=1e5)
+    pocket: float = param(0.05, "m", ge=0.0, le=1.0)
+    friction_damping: float = param(200.0, "N s/m", ge=0.0, le=1e6)
+    friction: float = param(0.8, "-", ge=0.0, le=10.0)
+    enabled: bool = param(True, doc="false: the hybrid primary falls freely")
 
     def validated(self) -> "BedSpringsParams":
         for name, unit in (("linear", "N/m"), ("damping", "N s/m"), ("pocket", "m"),

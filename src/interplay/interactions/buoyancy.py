@@ -1,40 +1,44 @@
 """A body in water (SPEC 2.4, objects in water): buoyancy and drag on the body, external
 pressure on the water.
 
-The body (primary: any system whose contact view's first part is a sphere or an ellipsoid
-primitive: a rigid Sphere, a KeyframedBody foot) is cut by the water's columns at every
-coupling step (``add_ellipsoid``).
-Water rising into it meets an external pressure that holds it down (kernels/water.py
-``heads``), so the water under it is pushed away and rises around it; the volume that
-pressure keeps out, V_sub, is what the body displaces. The water acts back with
+The body (primary: any system whose contact view is a BodiesView with sphere, ellipsoid,
+capsule or box primitives: a rigid Sphere, a KeyframedBody foot, a figure's 17 segments) is
+cut by the water's columns at every coupling step (``Water.add_solids``; its parts are
+interactions/immersion.py ``ImmersedParts``). Water rising into a part meets an external
+pressure that holds it down (kernels/water.py ``heads``), so the water under it is pushed away
+and rises around it; the volume that pressure keeps out, V_sub, is what the part displaces.
+The water acts back on every part with
 
-* buoyancy rho g V_sub (up) at the centre of buoyancy;
-* drag -1/2 rho C_d A |v_rel| v_rel, A the frontal area times the submerged fraction and
-  v_rel the body's velocity relative to the water around it (the column flow velocity, and the
-  surface's vertical speed);
-* rotational drag -C_r rho r^5 f |w| w on a spinning body (f the submerged fraction; r the
-  body's mean radius), so waves that tip the centre of buoyancy do not spin a ball forever;
-* optionally added mass -C_a rho V_sub a_body, with a_body lagged one coupling step (explicit:
-  stable only while C_a rho V_body < m_body, which the constructor checks).
+* buoyancy rho g V_sub (up) at its centre of buoyancy;
+* drag by the part's shape (immersion.py), scaled by its submerged fraction, relative to the
+  water around it (the column flow velocity, and the surface's vertical speed);
+* rotational drag, so waves that tip the centre of buoyancy do not spin a ball forever and a
+  limb swung under water is resisted;
+* optionally added mass -C_a rho V_sub a_part, with a_part lagged one coupling step (explicit:
+  stable only while C_a rho V_part < m_part, which the constructor checks).
 
 Two-way applies both sides; one-way only the pressure on the water (the log still records
 what the body would feel).
 """
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, SceneError, require_nonnegative
+from ..errors import ParameterError, require_nonnegative
+from ..params import param
 from .base import Interaction
+from .immersion import ImmersedParts
 
 #: fewer columns than this across a body and the grid cannot resolve it
 MIN_COLUMNS_ACROSS = 2
 #: columns across a body the resolution warning recommends
 GOOD_COLUMNS_ACROSS = 4
+
+
+_ZERO = np.zeros(3)
 
 
 class ResolutionWarning(UserWarning):
@@ -43,29 +47,26 @@ class ResolutionWarning(UserWarning):
 
 @dataclass(frozen=True)
 class BuoyancyParams:
-    """drag: C_d (-); rotational_drag: C_r (-); added_mass: C_a (-, 0.5 for a sphere, 0 off)."""
-    drag: float = 0.47
-    rotational_drag: float = 0.5
-    added_mass: float = 0.0
+    """Drag coefficients (-) of the parts' shapes (interactions/immersion.py): drag C_d of a
+    sphere or ellipsoid; normal_drag C_n of a capsule broadside and of a box's faces (a blunt
+    body); axial_drag C_a of a capsule end-on (a rounded nose); rotational_drag C_r of a
+    spinning sphere; added_mass C_a (-, 0.5 for a sphere, 0 off)."""
+    drag: float = param(0.47, "-", ge=0.0, le=100.0, doc="C_d of a sphere or ellipsoid")
+    normal_drag: float = param(1.0, "-", ge=0.0, le=100.0, doc="C_n of a capsule broadside")
+    axial_drag: float = param(0.3, "-", ge=0.0, le=100.0, doc="C_a of a capsule end-on")
+    rotational_drag: float = param(0.5, "-", ge=0.0, le=100.0, doc="C_r")
+    added_mass: float = param(0.0, "-", ge=0.0, le=10.0, doc="C_a (0.5 for a sphere)")
 
     def validated(self, owner):
-        require_nonnegative(owner, "drag coefficient", self.drag)
-        require_nonnegative(owner, "rotational drag coefficient", self.rotational_drag)
-        require_nonnegative(owner, "added-mass coefficient", self.added_mass)
+        for name in ("drag", "normal_drag", "axial_drag", "rotational_drag", "added_mass"):
+            require_nonnegative(owner, name.replace("_", " ") + " coefficient",
+                                getattr(self, name))
         return self
 
-
-def body_ellipsoid(view):
-    """(semi-axes (3,) m, rotation (3, 3), whether it turns with the body) of the ellipsoid of
-    a BodiesView's first part: its sphere or ellipsoid primitive (a sphere's rotation does not
-    matter: the identity)."""
-    prim = view.primitives[0] if view is not None and view.kind == "bodies" else None
-    if prim is not None and prim.kind == "sphere":
-        return np.full(3, float(prim.radius)), np.eye(3), False
-    if prim is not None and prim.kind == "ellipsoid":
-        return np.asarray(prim.axes, dtype=float), view.poses()[1][0], True
-    raise SceneError(f"{view.name if view is not None else 'the body'} has no shape the water "
-                     "can displace (its contact view needs a sphere or ellipsoid primitive)")
+    @property
+    def form(self) -> tuple:
+        """(C_d, C_n, C_a): what ``ImmersedParts.drag`` takes."""
+        return self.drag, self.normal_drag, self.axial_drag
 
 
 class BodyInWater(Interaction):
@@ -76,13 +77,8 @@ class BodyInWater(Interaction):
         super().__init__(name, body, water, mode, standin)
         self.p = params.validated(name)
         self.body = body.contact_view()
-        axes, R, self._turns = body_ellipsoid(self.body)
-        self.axes = np.asarray(axes, dtype=float)
-        self.volume = 4.0 / 3.0 * math.pi * float(np.prod(self.axes))  # m^3
-        self.radius = float(np.prod(self.axes)) ** (1.0 / 3.0)  # m, of the equal-volume sphere
-        self.area = math.pi * self.radius ** 2  # m^2, frontal area used by the drag
-        self._set_rotation(R)
-        across = 2.0 * min(math.sqrt(self._M[0, 0]), math.sqrt(self._M[1, 1]))
+        self.parts = ImmersedParts(self.body)
+        across = float(self.parts.width.max())
         l = water.spacing
         if across < MIN_COLUMNS_ACROSS * l:
             warnings.warn(
@@ -90,25 +86,25 @@ class BodyInWater(Interaction):
                 f"{l:.3g} m wide, too coarse to resolve it; use columns of at most "
                 f"{across / GOOD_COLUMNS_ACROSS:.3g} m ({GOOD_COLUMNS_ACROSS} across it)",
                 ResolutionWarning, stacklevel=2)
-        m_added = self.p.added_mass * water.rho * self.volume
-        if m_added >= self.body.masses[0]:
+        m_added = self.p.added_mass * water.rho * self.parts.volume
+        bad = np.flatnonzero(m_added >= self.parts.masses)
+        if len(bad):
+            k = bad[0]
+            part = self.body.names[self.parts.parts[k]]
             raise ParameterError(
-                f"{name}: added mass {m_added:.3g} kg (C_a {self.p.added_mass}) is not below "
-                f"{body.name}'s mass {body.mass:.3g} kg; the lagged added-mass force would be "
-                f"unstable: use added_mass < {body.mass / (water.rho * self.volume):.3g} or 0")
-        self._out = np.zeros(7)
+                f"{name}: added mass {m_added[k]:.3g} kg (C_a {self.p.added_mass}) is not "
+                f"below {part}'s mass {self.parts.masses[k]:.3g} kg; the lagged added-mass "
+                "force would be unstable: use added_mass < "
+                f"{float((self.parts.masses / (water.rho * self.parts.volume)).min()):.3g} or 0")
+        self._out = np.zeros((self.parts.count, 7))
         self._h = 0.0
-        self._v_prev = self.body.velocities()[0][0].copy()
-        self._zero = np.zeros(3)
-
-    def _set_rotation(self, R):
-        a2 = self.axes ** 2
-        self._M = np.ascontiguousarray(R @ np.diag(a2) @ R.T)
-        self._A = np.ascontiguousarray(R @ np.diag(1.0 / a2) @ R.T)
+        self.parts.update()
+        self._v_prev = self.parts.velocity.copy()
 
     def prepare(self, h, dts=None):
         self._h = h
-        self._v_prev[:] = self.body.velocities()[0][0]
+        self.parts.update()
+        self._v_prev[:] = self.parts.velocity
 
     def capture(self):
         return {"v_prev": self._v_prev.copy()}
@@ -117,33 +113,37 @@ class BodyInWater(Interaction):
         self._v_prev[:] = snap["v_prev"]
 
     def exchange(self, to_primary, to_secondary):
-        body, water, p = self.body, self.secondary, self.p
-        if self._turns:
-            self._set_rotation(body.poses()[1][0])
-        x = body.centres()[0]
-        lin, ang = body.velocities()
-        v, w = lin[0], ang[0]
-        lids = water.add_ellipsoid(x, float(v[2]), self._A, self._M, self.volume,
-                                   keep=to_secondary)
-        out = water.body_load(lids, self._out)
-        vsub = out[0]
-        acc = (v - self._v_prev) / self._h if self._h > 0.0 else self._zero
+        water, p, parts = self.secondary, self.p, self.parts
+        solids = parts.update()
+        v = parts.velocity
+        acc = (v - self._v_prev) / self._h if self._h > 0.0 else np.zeros_like(v)
         self._v_prev[:] = v
-        if vsub <= 0.0:
-            return self._zero, self._zero, False
+        if not to_secondary:
+            return _ZERO, _ZERO, False  # the water's push is only known once it is pressed
+        out = water.solid_loads(water.add_solids(solids), self._out)
+        vsub = out[:, 0]
+        wet = vsub > 0.0
+        if not wet.any():
+            return _ZERO, _ZERO, False
         rho = water.rho
-        frac = vsub / self.volume
-        buoy = np.array([0.0, 0.0, rho * water.g * vsub])
-        vrel = v - out[4:7]
-        force = buoy - 0.5 * rho * p.drag * self.area * frac * np.linalg.norm(vrel) * vrel
+        frac = vsub / parts.volume
+        buoy = np.zeros_like(v)
+        buoy[:, 2] = rho * water.g * vsub
+        force = buoy + parts.drag(v - out[:, 4:7], frac, rho, p.form)
         if p.added_mass > 0.0:
-            force -= p.added_mass * rho * vsub * acc
-        torque = np.cross(out[1:4] - x, buoy)
-        torque -= p.rotational_drag * rho * self.radius ** 5 * frac * np.linalg.norm(w) * w
-        if to_primary:
-            body.apply(0, force, torque)
-        return force, torque, True
+            force -= p.added_mass * rho * vsub[:, None] * acc
+        torque = np.cross(out[:, 1:4] - parts.com, buoy) + np.cross(
+            solids.centre - parts.com, force - buoy)
+        torque += parts.rotational_drag(parts.spin, frac, rho, p.normal_drag,
+                                        p.rotational_drag)
+        f, t = parts.exert(wet, force, torque, apply=to_primary)
+        return f, t, True
 
     def submerged(self):
-        """The last exchange's submerged volume (m^3) and centre of buoyancy (m)."""
-        return float(self._out[0]), self._out[1:4].copy()
+        """The last exchange's submerged volume (m^3) and centre of buoyancy (m) of the body
+        (all its parts)."""
+        out = self._out
+        v = float(out[:, 0].sum())
+        if v <= 0.0:
+            return 0.0, self.parts.com.mean(axis=0)
+        return v, (out[:, 0:1] * out[:, 1:4]).sum(axis=0) / v

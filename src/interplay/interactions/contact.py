@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError, require_nonnegative, require_positive
+from ..params import param
 from ..kernels.contact import Sphere, colliders, sphere_elements, sphere_plane
 from ..kernels.springs import point_forces
 from ..systems.base import substeps
@@ -25,12 +26,12 @@ class ContactParams:
     """stiffness c_s (N/m), damping c_d (N s/m), friction mu (-), eps: the slip speed (m/s)
     below which friction is viscous; thickness: contact skin, e.g. a cord's radius (m);
     constraint: include the constraint term f_c."""
-    stiffness: float = 2.0e3
-    damping: float = 2.0
-    friction: float = 0.5
-    eps: float = 0.05
-    thickness: float = 0.003
-    constraint: bool = True
+    stiffness: float = param(2.0e3, "N/m", ge=1e-6, le=1e9, doc="penalty stiffness c_s")
+    damping: float = param(2.0, "N s/m", ge=0.0, le=1e7, doc="penalty damping c_d")
+    friction: float = param(0.5, "-", ge=0.0, le=10.0, doc="Coulomb coefficient mu")
+    eps: float = param(0.05, "m/s", ge=1e-6, le=100.0, doc="slip speed of full friction")
+    thickness: float = param(0.003, "m", ge=0.0, le=1.0, doc="contact skin")
+    constraint: bool = param(True, doc="include the constraint force f_c")
 
     def validated(self, owner: str) -> "ContactParams":
         require_positive(owner, "contact stiffness", self.stiffness, "N/m")

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError, require_nonnegative, require_positive
+from ..params import param
 from ..kernels.contact import points_on_plane
 from ..kernels.springs import point_forces
 from .base import Interaction
@@ -24,11 +25,11 @@ class GroundParams:
     per kg, 1/s): 300 is about half critical at that stiffness; friction: mu; eps (m/s):
     sliding speed below which friction is viscous; thickness (m): contact offset above the
     plane (half a leaf's thickness, so it does not look sunk)."""
-    stiffness: float = 1.0e5
-    damping: float = 300.0
-    friction: float = 0.6
-    eps: float = 0.01
-    thickness: float = 0.001
+    stiffness: float = param(1.0e5, "1/s^2", ge=1e-6, le=1e10, doc="per kg of point mass")
+    damping: float = param(300.0, "1/s", ge=0.0, le=1e7, doc="per kg of point mass")
+    friction: float = param(0.6, "-", ge=0.0, le=10.0)
+    eps: float = param(0.01, "m/s", ge=1e-6, le=100.0)
+    thickness: float = param(0.001, "m", ge=0.0, le=1.0)
 
 
 class GroundContact(Interaction):

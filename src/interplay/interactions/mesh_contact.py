@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
+from ..params import param
 from ..geometry.aabb_tree import AABBTree, check_points, check_thickness
 from ..kernels.aabb_tree import deepest_on_segments
 from ..kernels.trimesh_contact import ContactForces, Contacts, respond, signed_triangle_distance
@@ -44,15 +45,15 @@ class MeshContactParams:
     kept this far (m) beyond the thickness, where the penalty turns negative and only
     lightens the constraint force, so a resting contact settles inside it instead of
     flickering at its edge (and losing its friction spring)."""
-    thickness: float = 0.005
-    depth: float = 0.05
-    friction: float = 0.5
-    eps: float = 0.01
-    stiffness: float | None = None
-    damping: float | None = None
-    contact_steps: float | None = None
+    thickness: float = param(0.005, "m", ge=0.0, le=1.0)
+    depth: float = param(0.05, "m", ge=0.0, le=10.0)
+    friction: float = param(0.5, "-", ge=0.0, le=10.0)
+    eps: float = param(0.01, "m/s", gt=0.0, le=100.0)
+    stiffness: float | None = param(None, "N/m", gt=0.0, le=1e9, doc="none: from the masses")
+    damping: float | None = param(None, "N s/m", ge=0.0, le=1e7, doc="none: from the masses")
+    contact_steps: float | None = param(None, "steps", ge=1.0, le=1000.0)
     constraint: bool = True
-    skin: float = 0.002
+    skin: float = param(0.002, "m", ge=0.0, le=1.0)
 
     def validated(self, owner: str) -> "MeshContactParams":
         check_thickness(owner, self.thickness)

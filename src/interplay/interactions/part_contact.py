@@ -29,6 +29,7 @@ import numpy as np
 from ..errors import ParameterError, SceneError, require_nonnegative, require_positive
 from ..kernels import part_contact as PC
 from ..kernels.springs import point_forces
+from ..params import param
 from .base import Interaction
 
 
@@ -40,14 +41,14 @@ class PartContactParams:
     substeps over which a penetration is resolved (with the default stiffness); constraint:
     include the constraint term; margin (m): how much farther than a part can reach in a step
     its candidate elements are gathered."""
-    thickness: float = 0.004
-    friction: float = 0.8
-    eps: float = 0.01
-    stiffness: float | None = None
-    damping: float | None = None
-    contact_steps: float = 3.0
-    constraint: bool = True
-    margin: float = 0.01
+    thickness: float = param(0.004, "m", ge=0.0, le=0.2)
+    friction: float = param(0.8, "-", ge=0.0, le=10.0)
+    eps: float = param(0.01, "m/s", gt=0.0, le=10.0)
+    stiffness: float | None = param(None, "N/m", gt=0.0, le=1e9, doc="None: per contact")
+    damping: float | None = param(None, "N s/m", ge=0.0, le=1e7, doc="None: per contact")
+    contact_steps: float = param(3.0, "substeps", ge=1.0, le=1000.0)
+    constraint: bool = param(True, doc="include the constraint term")
+    margin: float = param(0.01, "m", ge=0.0, le=1.0)
 
     def validated(self, owner: str) -> "PartContactParams":
         require_nonnegative(owner, "contact thickness", self.thickness, "m")

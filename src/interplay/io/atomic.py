@@ -9,6 +9,16 @@ from pathlib import Path
 from ..errors import InterplayError
 
 
+def _file_mode() -> int:
+    """The mode a new file gets here (0644 under the usual umask 022): mkstemp makes 0600."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+FILE_MODE = _file_mode()
+
+
 @contextmanager
 def atomic_path(path):
     """Yield a temporary path beside ``path``; rename it onto ``path`` only if the block succeeds."""
@@ -22,6 +32,7 @@ def atomic_path(path):
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, FILE_MODE)  # readable like any file the user writes, not 0600
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):

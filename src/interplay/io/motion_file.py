@@ -83,11 +83,33 @@ def _axis_rotation(axis: str, a: np.ndarray) -> np.ndarray:
     return R
 
 
+#: the largest BVH file read (bytes): a 10-minute 120 Hz clip of a 30-joint skeleton is ~40 MB
+MAX_BYTES = 64 * 2 ** 20
+#: frame counts and frame times a clip may have: at least two frames to interpolate between;
+#: from 10,000 down to 1 frame per second
+MAX_FRAMES = 1_000_000
+FRAME_TIME = (1e-4, 1.0)  # s
+MAX_JOINTS = 512
+
+
+def check_file(path) -> Path:
+    """``path`` if it is a regular file no larger than MAX_BYTES; BVHError otherwise (a FIFO,
+    a device such as /dev/zero, a folder or a missing file is refused before it is opened)."""
+    from .inputs import regular_file
+    return regular_file(path, MAX_BYTES, "BVH clip", BVHError)
+
+
 def read_bvh(path) -> Motion:
-    """Read a BVH file; BVHError naming the line for anything malformed."""
-    path = Path(path)
+    """Read a BVH file; BVHError naming the line for anything malformed. The file must be a
+    regular file of at most MAX_BYTES, with 2 to MAX_FRAMES frames, a Frame Time within
+    FRAME_TIME, exactly as many motion lines as ``Frames:`` says, and finite numbers."""
+    path = check_file(path)
     try:
-        lines = path.read_text().splitlines()
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+        if len(data) > MAX_BYTES:  # it grew after the check
+            raise BVHError(f"{path}: larger than {MAX_BYTES // 2 ** 20} MiB; trim the clip")
+        lines = data.decode("utf-8").splitlines()
     except (OSError, UnicodeDecodeError) as e:
         raise BVHError(f"{path}: cannot read BVH file ({e})") from None
     where = lambda n: f"{path}:{n + 1}"  # noqa: E731
@@ -111,6 +133,9 @@ def read_bvh(path) -> Motion:
             raise BVHError(f"{where(line)}: expected a number, got {bad!r}") from None
         if len(vals) != k:
             raise BVHError(f"{where(line)}: expected {k} numbers, got {len(vals)}")
+        bad = [t for t, v in zip(toks, vals) if not np.isfinite(v)]
+        if bad:
+            raise BVHError(f"{where(line)}: {bad[0]!r} is not a finite number")
         return np.array(vals)
 
     if nxt() != ["HIERARCHY"]:
@@ -146,6 +171,8 @@ def read_bvh(path) -> Motion:
             jt.channels, jt.first = t[2:], nchan
             nchan += k
             joints.append(jt)
+            if len(joints) > MAX_JOINTS:
+                raise BVHError(f"{where(n - 1)}: more than {MAX_JOINTS} joints")
             stack.append(len(joints) - 1)
         elif kw == "End":
             if nxt() != ["{"]:
@@ -172,15 +199,26 @@ def read_bvh(path) -> Motion:
     if len(t) != 2 or t[0] != "Frames:" or not t[1].isdigit():
         raise BVHError(f"{where(n - 1)}: expected 'Frames: <count>'")
     nframes = int(t[1])
+    if not 2 <= nframes <= MAX_FRAMES:
+        raise BVHError(f"{where(n - 1)}: Frames: {nframes}; a clip needs 2 to {MAX_FRAMES:,} "
+                       "frames")
     t = nxt()
-    if len(t) != 3 or t[:2] != ["Frame", "Time:"] or not _is_float(t[2]) or float(t[2]) <= 0:
+    if len(t) != 3 or t[:2] != ["Frame", "Time:"] or not _is_float(t[2]):
         raise BVHError(f"{where(n - 1)}: expected 'Frame Time: <seconds>'")
     frame_time = float(t[2])
+    if not FRAME_TIME[0] <= frame_time <= FRAME_TIME[1]:
+        raise BVHError(f"{where(n - 1)}: Frame Time: {t[2]} s must be within {FRAME_TIME[0]:g} "
+                       f"to {FRAME_TIME[1]:g} s (10,000 to 1 frames per second)")
+    if nchan == 0:
+        raise BVHError(f"{path}: the hierarchy has no CHANNELS: there is no motion to read")
     first = n
     body = [i for i in range(first, len(lines)) if lines[i].strip()]
     if len(body) < nframes:
         raise BVHError(f"{path}: Frames: says {nframes} but only {len(body)} motion lines follow "
                        f"(truncated after line {body[-1] + 1 if body else first})")
+    if len(body) > nframes:
+        raise BVHError(f"{where(body[nframes])}: Frames: says {nframes} but {len(body)} motion "
+                       "lines follow; fix the count")
     frames = np.zeros((nframes, nchan))
     for f, i in enumerate(body[:nframes]):
         frames[f] = floats(lines[i].split(), nchan, i)

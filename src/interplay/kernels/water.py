@@ -1,5 +1,9 @@
 """Water kernels (O'Brien & Hodgins 1995): virtual-pipe columns, spray particles, bodies.
 
+Bodies are solids (kernels/lids.py: ellipsoids, capsules, boxes) registered as lids over the
+columns they shadow (lids.py ``add_solids``, ``group_lids``); ``heads`` turns the lids into external
+pressure and ``solid_loads`` gives each solid the water's push back.
+
 Grid: column (i, j) has its centre at (x0 + i l, y0 + j l); arrays are (nx, ny). Each pipe is
 stored once, from a column to its neighbour in direction k: +x, +y, +x+y, +x-y, so
 ``Q[k, i, j]`` (m^3/s) is the flow from (i, j) to (i + DI[k], j + DJ[k]).
@@ -23,11 +27,17 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .lids import content, lid_sample, merged, run_end, column_level
+
 SQRT2 = math.sqrt(2.0)
 #: floor on the depth (m) used to turn a column's flows into a velocity (no 0/0 when dry)
 VELOCITY_DEPTH_FLOOR = 1e-3
 #: outflow limit as a fraction of the column's volume: rounding can never make it negative
 _KEEP = 1.0 - 1e-12
+#: State.track: peak airborne particles, shallowest fluid column (m), highest particle (m),
+#: particles emitted in all
+PEAK, MIN_DEPTH, HIGHEST, EMITTED = 0, 1, 2, 3
+TRACKED = 4
 
 
 class Grid(NamedTuple):
@@ -49,8 +59,8 @@ class Grid(NamedTuple):
 class State(NamedTuple):
     """The water's state: V (nx, ny) column volumes (m^3), Q (4, nx, ny) pipe flows (m^3/s),
     ext (nx, ny) the external pressure head (m), rate (nx, ny) the surface's vertical speed
-    (m/s), px, pv (cap, 3) spray positions (m) and velocities (m/s), track (2,) the peak
-    particle count and the shallowest fluid column (m) seen."""
+    (m/s), px, pv (cap, 3) spray positions (m) and velocities (m/s), track (TRACKED,): what
+    the run has seen (the indices below)."""
     V: np.ndarray
     Q: np.ndarray
     ext: np.ndarray
@@ -58,17 +68,6 @@ class State(NamedTuple):
     px: np.ndarray
     pv: np.ndarray
     track: np.ndarray
-
-
-class Lids(NamedTuple):
-    """Where bodies cut the columns: cell (k,) a column's flat index, zlo, zhi (k, s^2) the
-    bottom and top (m) of the body's vertical chord at each sample point, scale (k,) the
-    volume scale, vz (k,) the body's vertical speed (m/s)."""
-    cell: np.ndarray
-    zlo: np.ndarray
-    zhi: np.ndarray
-    scale: np.ndarray
-    vz: np.ndarray
 
 
 class Settings(NamedTuple):
@@ -106,83 +105,30 @@ def _dir(k):
     return 1, -1
 
 
-@njit(cache=True, inline="always")
-def _content(H, b, lo, chord, kappa):
-    """Water (m of column height) a sample point under a body holds when the column's head is
-    H, and its slope dC/dH. Below the body's bottom lo the water is free; above it, water
-    pressed a height e into the body meets the penalty head kappa e (so e = (H - lo) /
-    (1 + kappa)), until that head reaches the chord: then the water stands on the body."""
-    if chord <= 0.0 or H <= lo:
-        return H - b, 1.0
-    if (H - lo) * kappa <= chord * (1.0 + kappa):
-        return lo - b + (H - lo) / (1.0 + kappa), 1.0 / (1.0 + kappa)
-    return H - b - chord, 1.0
-
-
-@njit(cache=True, inline="always")
-def _lid_sample(zlo, zhi, scale, b):
-    """Bottom (m, not below the bed b) and volume-scaled chord (m) of a lid's sample."""
-    lo = max(zlo, b)
-    return lo, scale * max(zhi - lo, 0.0)
-
-
-@njit(cache=True)
-def lid_level(eta, b, zlo, zhi, scale, kappa):
-    """The head H (m) of a column under a body: the root of mean_s C_s(H) = eta - b (its
-    water), a monotone piecewise-linear equation solved by Newton's method kept inside a
-    bracket (exact once on the right linear piece)."""
-    ns2 = zlo.shape[0]
-    target = eta - b
-    cmax = 0.0
-    for s in range(ns2):
-        cmax = max(cmax, _lid_sample(zlo[s], zhi[s], scale, b)[1])
-    a, z = eta, eta + cmax * (1.0 + 1.0 / kappa) + 1e-12
-    H = eta
-    for _ in range(60):
-        c = 0.0
-        dc = 0.0
-        for s in range(ns2):
-            lo, ch = _lid_sample(zlo[s], zhi[s], scale, b)
-            ci, di = _content(H, b, lo, ch, kappa)
-            c += ci
-            dc += di
-        f = c / ns2 - target
-        if abs(f) <= 1e-14 * (abs(target) + abs(H)):
-            break
-        if f > 0.0:
-            z = H
-        else:
-            a = H
-        Hn = H - f * ns2 / dc
-        H = Hn if a < Hn < z else 0.5 * (a + z)
-    return H
-
-
 @njit(cache=True)
 def heads(grid, V, lids, n_lid, kappa, ext, eta, H):
     """Fill the surface eta, the external pressure head ext and the pressure head H (m).
 
     Bodies are given as *lids*: a column (flat index) with, at each of its sample points, the
-    bottom and top (m) of the body's vertical chord, and a volume scale. Within a
-    column the water is hydrostatic: the free part stands at H, the part under the body is
-    held down by the pressure the body exerts (``_content``). ext = H - eta is the body's
-    pressure head; it is a function of the water's own state, so the coupling stores and
-    returns energy like a spring instead of pumping it. (Two bodies over one column add.)"""
+    bottom and top (m) of a body's vertical chord, and a volume scale. Within a column the
+    water is hydrostatic: the free part stands at H, the part under the bodies is held down
+    by the pressure they exert (``content``; several bodies over one column are packed,
+    ``merged``). ext = H - eta is the bodies' pressure head; it is a function of the water's
+    own state, so the coupling stores and returns energy like a spring instead of pumping
+    it."""
     bed, area = grid.bed, grid.area
-    lid_cell, lid_zlo, lid_zhi, lid_scale = lids.cell, lids.zlo, lids.zhi, lids.scale
+    cell = lids.cell
     nx, ny = V.shape
     inv = 1.0 / area
     for i in range(nx):
         for j in range(ny):
             eta[i, j] = bed[i, j] + V[i, j] * inv
-    for k in range(n_lid):
-        c = lid_cell[k]
-        ext[c // ny, c % ny] = 0.0
-    for k in range(n_lid):
-        c = lid_cell[k]
-        i, j = c // ny, c % ny
-        ext[i, j] += lid_level(eta[i, j], bed[i, j], lid_zlo[k], lid_zhi[k], lid_scale[k],
-                               kappa) - eta[i, j]
+    k = 0
+    while k < n_lid:
+        k1 = run_end(cell, k, n_lid)
+        i, j = cell[k] // ny, cell[k] % ny
+        ext[i, j] = column_level(eta[i, j], bed[i, j], lids, k, k1, kappa) - eta[i, j]
+        k = k1
     for i in range(nx):
         for j in range(ny):
             H[i, j] = eta[i, j] + ext[i, j]
@@ -328,9 +274,10 @@ def emit_spray(grid, state, settings, H, count, dt):
     number from a column is fraction * l^2 (rate - threshold) dt / vp, rounded stochastically,
     placed uniformly over the column at its surface with the surface's interpolated velocity.
     Each particle's volume vp (m^3, radius m) leaves its column; columns shallower than four
-    radii do not spray. Returns the new particle count."""
+    radii do not spray. Counts the particles into state.track[EMITTED]. Returns the new
+    particle count."""
     fluid, area, l, x0, y0 = grid.fluid, grid.area, grid.l, grid.x0, grid.y0
-    V, rate, px, pv = state.V, state.rate, state.px, state.pv
+    V, rate, px, pv, track = state.V, state.rate, state.px, state.pv, state.track
     threshold, fraction, vp, radius = (settings.threshold, settings.fraction, settings.vp,
                                        settings.radius)
     nx, ny = V.shape
@@ -346,7 +293,8 @@ def emit_spray(grid, state, settings, H, count, dt):
             if n >= cap:
                 return n
             k = int(fraction * area * (r - threshold) * dt / vp + np.random.random())
-            k = min(k, int(V[i, j] / vp), cap - n)
+            k = min(k, int(V[i, j] * _KEEP / vp), cap - n)  # never below empty
+            track[EMITTED] += k
             for _ in range(k):
                 x = x0 + (i + np.random.random() - 0.5) * l
                 y = y0 + (j + np.random.random() - 0.5) * l
@@ -384,9 +332,10 @@ def _land(V, fluid, i, j, vp):
 def move_spray(grid, state, settings, H, count, dt):
     """Ballistic flight with quadratic air drag (a = g - drag |v| v, drag in 1/m). A particle
     that falls to the surface (or onto a wall) gives its volume back around the fluid column
-    below it (the nearest fluid column, off the water). Returns the new count."""
+    below it (the nearest fluid column, off the water). The highest particle goes into
+    state.track[HIGHEST]. Returns the new count."""
     fluid, bed, nearest, x0, y0, l = grid.fluid, grid.bed, grid.nearest, grid.x0, grid.y0, grid.l
-    V, px, pv = state.V, state.px, state.pv
+    V, px, pv, track = state.V, state.px, state.pv, state.track
     g, drag, vp = settings.g, settings.drag, settings.vp
     nx, ny = V.shape
     n = count
@@ -398,6 +347,8 @@ def move_spray(grid, state, settings, H, count, dt):
         pv[p, 2] += dt * (-g - drag * sp * pv[p, 2])
         for c in range(3):
             px[p, c] += dt * pv[p, c]
+        if px[p, 2] > track[HIGHEST]:
+            track[HIGHEST] = px[p, 2]
         i = min(max(int(math.floor((px[p, 0] - x0) / l + 0.5)), 0), nx - 1)
         j = min(max(int(math.floor((px[p, 1] - y0) / l + 0.5)), 0), ny - 1)
         ground = H[i, j] if fluid[i, j] else bed[i, j]
@@ -441,12 +392,12 @@ def advance(grid, state, lids, n_lid, settings, scratch, count, seed, h, dt_max)
             for s in range(lid_zlo.shape[1]):
                 lid_zlo[k, s] += lid_vz[k] * dt
                 lid_zhi[k, s] += lid_vz[k] * dt
-        if count > track[0]:
-            track[0] = count
+        if count > track[PEAK]:
+            track[PEAK] = count
     for i in range(nx):
         for j in range(ny):
-            if fluid[i, j] and V[i, j] / area < track[1]:
-                track[1] = V[i, j] / area
+            if fluid[i, j] and V[i, j] / area < track[MIN_DEPTH]:
+                track[MIN_DEPTH] = V[i, j] / area
     return count, nsub
 
 
@@ -482,106 +433,72 @@ def energy_momentum(grid, state, rho, count, vp, out):
     out[3] = mz
 
 
-@njit(cache=True, inline="always")
-def _chord(c, A, x, y):
-    """Vertical chord (zlo, zhi) of the ellipsoid at (x, y); zlo > zhi when it misses."""
-    dx = x - c[0]
-    dy = y - c[1]
-    bq = A[0, 2] * dx + A[1, 2] * dy
-    cq = A[0, 0] * dx * dx + 2.0 * A[0, 1] * dx * dy + A[1, 1] * dy * dy - 1.0
-    disc = bq * bq - A[2, 2] * cq
-    if disc <= 0.0:
-        return 1.0, 0.0
-    r = math.sqrt(disc)
-    return c[2] + (-bq - r) / A[2, 2], c[2] + (-bq + r) / A[2, 2]
-
-
 @njit(cache=True)
-def add_ellipsoid(c, vz, A, M, full_volume, grid, ns, lids, n):
-    """Append the lids of the ellipsoid {p : (p - c)^T A (p - c) <= 1} (M = A^-1: its
-    horizontal half extents are sqrt(M00), sqrt(M11)) moving up at vz (m/s) from index n: one
-    per fluid column its shadow touches, sampled at ns x ns points. The scale full_volume /
-    (sampled volume) gives the sampled body its exact volume. Returns the new count, or -1
-    if the buffers are too small."""
-    fluid, x0, y0, l = grid.fluid, grid.x0, grid.y0, grid.l
-    lid_cell, lid_zlo, lid_zhi, lid_scale, lid_vz = lids
-    nx, ny = fluid.shape
-    ex = math.sqrt(M[0, 0])
-    ey = math.sqrt(M[1, 1])
-    i_lo = int(math.floor((c[0] - ex - x0) / l + 0.5))
-    i_hi = int(math.floor((c[0] + ex - x0) / l + 0.5))
-    j_lo = int(math.floor((c[1] - ey - y0) / l + 0.5))
-    j_hi = int(math.floor((c[1] + ey - y0) / l + 0.5))
-    sampled = 0.0
-    start = n
-    for i in range(i_lo, i_hi + 1):
-        for j in range(j_lo, j_hi + 1):
-            inside = 0 <= i < nx and 0 <= j < ny and fluid[i, j]
-            if inside and n >= lid_cell.shape[0]:
-                return -1
-            touched = False
-            for si in range(ns):
-                x = x0 + (i - 0.5 + (si + 0.5) / ns) * l
-                for sj in range(ns):
-                    zlo, zhi = _chord(c, A, x, y0 + (j - 0.5 + (sj + 0.5) / ns) * l)
-                    if zhi <= zlo:
-                        zlo = zhi = -1e30  # no body here: a chord of zero length
-                    else:
-                        sampled += (zhi - zlo) * l * l / (ns * ns)
-                        touched = True
-                    if inside:
-                        lid_zlo[n, si * ns + sj] = zlo
-                        lid_zhi[n, si * ns + sj] = zhi
-            if inside and touched:
-                lid_cell[n] = i * ny + j
-                lid_vz[n] = vz
-                n += 1
-    for k in range(start, n):
-        lid_scale[k] = full_volume / sampled
-    return n
-
-
-@njit(cache=True)
-def lid_load(grid, state, lids, start, stop, kappa, out):
-    """What the water does to the body whose lids are [start, stop): out = [displaced volume
-    (m^3: the sum of pressure head times column area, so rho g out[0] is the force), centre of
-    buoyancy (3) m, water velocity (3) m/s]; the velocity is load-weighted, horizontal from the
-    flows, vertical the surface's scaled by the height above the bed."""
+def solid_loads(grid, state, lids, n_lid, o0, o1, kappa, out):
+    """What the water does to solids o0..o1-1 (owners of lids): out (o1 - o0, 7) = [displaced
+    volume (m^3: head kept out times column area, so rho g out[0] is the force), centre of
+    buoyancy (3) m, water velocity (3) m/s]. Where several solids share a sample, the water
+    the column's head keeps out is given to them bottom up (each gets what is left above the
+    chords of the solids below it, up to its own chord), so the solids together carry exactly
+    the pressure the water bears. The velocity is load-weighted: horizontal from the column's
+    flows, vertical the surface's rise scaled by the height above the bed."""
     pipe, bed, area, x0, y0, l, w = grid.pipe, grid.bed, grid.area, grid.x0, grid.y0, grid.l, grid.w
     V, Q, rate = state.V, state.Q, state.rate
-    lid_cell, lid_zlo, lid_zhi, lid_scale = lids.cell, lids.zlo, lids.zhi, lids.scale
+    cell, owner, zlo, zhi, scale = lids.cell, lids.owner, lids.zlo, lids.zhi, lids.scale
     nx, ny = V.shape
-    ns2 = lid_zlo.shape[1]
+    ns2 = zlo.shape[1]
     ns = int(round(math.sqrt(ns2)))
-    out[:] = 0.0
-    tot = 0.0
-    for k in range(start, stop):
-        cell = lid_cell[k]
-        i, j = cell // ny, cell % ny
+    out[:, :] = 0.0
+    k = 0
+    while k < n_lid:
+        k1 = run_end(cell, k, n_lid)
+        mine = False
+        for m in range(k, k1):
+            mine = mine or o0 <= owner[m] < o1
+        if not mine:
+            k = k1
+            continue
+        i, j = cell[k] // ny, cell[k] % ny
         b = bed[i, j]
-        e = b + V[i, j] / area
-        H = lid_level(e, b, lid_zlo[k], lid_zhi[k], lid_scale[k], kappa)
-        col = 0.0
+        H = column_level(b + V[i, j] / area, b, lids, k, k1, kappa)
+        u, v = column_velocity(Q, V, pipe, i, j, area, w)
         for s in range(ns2):
-            lo, ch = _lid_sample(lid_zlo[k, s], lid_zhi[k, s], lid_scale[k], b)
-            c, _ = _content(H, b, lo, ch, kappa)
-            head = H - b - c  # what the body keeps out of this sample (m)
+            lo, ch = merged(lids, k, k1, s, b)
+            if ch <= 0.0:
+                continue
+            c, _ = content(H, b, lo, ch, kappa)
+            head = H - b - c  # what the bodies keep out of this sample (m)
             if head <= 0.0:
                 continue
-            dv = head * area / ns2
-            zc = lo + 0.5 * head
-            col += dv
-            out[1] += dv * (x0 + (i - 0.5 + (s // ns + 0.5) / ns) * l)
-            out[2] += dv * (y0 + (j - 0.5 + (s % ns + 0.5) / ns) * l)
-            out[3] += dv * zc
-            # shallow water: the vertical velocity grows linearly from the bed to the surface
-            out[6] += dv * rate[i, j] * min(max((zc - b) / max(H - b, 1e-9), 0.0), 1.0)
-        if col > 0.0:
-            tot += col
-            u, v = column_velocity(Q, V, pipe, i, j, area, w)
-            out[4] += col * u
-            out[5] += col * v
-    if tot > 0.0:
-        for r in range(1, 7):
-            out[r] /= tot
-        out[0] = tot
+            x = x0 + (i - 0.5 + (s // ns + 0.5) / ns) * l
+            y = y0 + (j - 0.5 + (s % ns + 0.5) / ns) * l
+            for m in range(k, k1):
+                if not o0 <= owner[m] < o1:
+                    continue
+                lm, cm = lid_sample(zlo[m, s], zhi[m, s], scale[m], b)
+                if cm <= 0.0:
+                    continue
+                below = 0.0
+                for q in range(k, k1):
+                    lq, cq = lid_sample(zlo[q, s], zhi[q, s], scale[q], b)
+                    if cq > 0.0 and (lq < lm or (lq == lm and q < m)):
+                        below += cq
+                share = min(max(head - below, 0.0), cm)
+                if share <= 0.0:
+                    continue
+                dv = share * area / ns2
+                zc = lm + 0.5 * share
+                r = out[owner[m] - o0]
+                r[0] += dv
+                r[1] += dv * x
+                r[2] += dv * y
+                r[3] += dv * zc
+                r[4] += dv * u
+                r[5] += dv * v
+                # shallow water: the vertical velocity grows linearly from the bed up
+                r[6] += dv * rate[i, j] * min(max((zc - b) / max(H - b, 1e-9), 0.0), 1.0)
+        k = k1
+    for o in range(o1 - o0):
+        if out[o, 0] > 0.0:
+            for q in range(1, 7):
+                out[o, q] /= out[o, 0]

@@ -11,15 +11,19 @@ and core radius r_c (m); the Python side (``systems.wind``) moves and gusts them
 
 where g(r) = r / (r^2 + r_c^2) regularizes 1/r (our choice, SPEC 2.2): it equals 1/r far from
 the core, peaks at r = r_c and vanishes at the centre instead of diverging.
+
+* TURBULENCE: frozen turbulence carried along with c (Taylor's hypothesis): a sum of Fourier
+  modes v = sum_m s A_m cos(k_m . d + phi_m), each divergence-free (A_m perpendicular to k_m);
+  modes (M, 8) rows [owner primitive, k (1/m), A (unit rms), phi (rad)], strength s (m/s rms).
 """
 import numpy as np
 from numba import njit
 
-UNIFORM, SOURCE, VORTEX = 0, 1, 2
+UNIFORM, SOURCE, VORTEX, TURBULENCE = 0, 1, 2, 3
 
 
 @njit(cache=True)
-def sample(points, kind, centre, axis, strength, core, out):
+def sample(points, kind, centre, axis, strength, core, modes, out):
     """out[i] = sum over primitives of their velocity (m/s) at points[i] (m)."""
     inv4pi = 1.0 / (4.0 * np.pi)
     inv2pi = 1.0 / (2.0 * np.pi)
@@ -39,7 +43,16 @@ def sample(points, kind, centre, axis, strength, core, out):
             d1 = points[i, 1] - centre[q, 1]
             d2 = points[i, 2] - centre[q, 2]
             rc2 = core[q] * core[q]
-            if kind[q] == SOURCE:
+            if kind[q] == TURBULENCE:
+                for m in range(modes.shape[0]):
+                    if int(modes[m, 0]) != q:
+                        continue
+                    c = s * np.cos(modes[m, 1] * d0 + modes[m, 2] * d1 + modes[m, 3] * d2
+                                   + modes[m, 7])
+                    o0 += c * modes[m, 4]
+                    o1 += c * modes[m, 5]
+                    o2 += c * modes[m, 6]
+            elif kind[q] == SOURCE:
                 r2 = d0 * d0 + d1 * d1 + d2 * d2
                 if r2 == 0.0:
                     continue

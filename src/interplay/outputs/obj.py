@@ -19,15 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InterplayError
-from .usd import prim_name, vertex_normals
-
-
-def quat_matrix(q) -> np.ndarray:
-    """Rotation matrix (3,3) of a unit quaternion (w,x,y,z)."""
-    w, x, y, z = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+from .geometry import quat_matrix, vertex_normals
+from .usd import prim_name
 
 
 def _rows(prefix: str, a: np.ndarray, item: str, items: int) -> str:

@@ -186,15 +186,9 @@ def _diagnostics(summary) -> str:
     return out
 
 
-def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
-                     output_timings: dict | None = None, video_info: dict | None = None
-                     ) -> list[Path]:
-    """Write report.html and its plots into out_dir; return their paths.
-
-    summary: the dict saved as summary.json (its advice may carry a compare's measurements);
-    files: {description: path} of the run's other outputs; video: the preview MP4 or None;
-    video_info: what render_video returned (size, fps, camera), for the caption.
-    """
+def force_plots(result, out_dir, summary: dict) -> tuple[list[Path], list[str]]:
+    """The report's force plot of every interaction that touched: (PNG paths, HTML parts).
+    Made apart from the page so that they draw while the preview renders."""
     from .render.plots import force_plot
     out = Path(out_dir)
     written, plots = [], []
@@ -213,10 +207,26 @@ def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
         plots.append(f'<h3>{_e(name)}</h3><img class="plot" src="{_e(_rel(p, out))}" '
                      f'alt="force of {_e(name)} on {_e(primary)} over time">'
                      + _windows_table(s))
+    return written, plots
+
+
+def write_run_report(result, out_dir, summary: dict, files: dict, video=None,
+                     output_timings: dict | None = None, video_info: dict | None = None,
+                     plots: tuple | None = None) -> list[Path]:
+    """Write report.html and its plots into out_dir; return their paths.
+
+    summary: the dict saved as summary.json (its advice may carry a compare's measurements);
+    files: {description: path} of the run's other outputs; video: the preview MP4 or None;
+    video_info: what render_video returned (size, fps, camera), for the caption; plots: what
+    ``force_plots`` returned, if it was called already.
+    """
+    out = Path(out_dir)
+    written, parts = plots if plots is not None else force_plots(result, out, summary)
+    written = list(written)
     rows, classes = table_i_rows(summary["interactions"], _masses(summary))
     sections = [
         ("video", "Preview", _video(video, out, _caption(video_info))),
-        ("interactions", "Interaction forces on the primary", "".join(plots)
+        ("interactions", "Interaction forces on the primary", "".join(parts)
          or "<p>No interactions.</p>"),
         ("table-i", "Table I statistics",
          "<p>Over the first contact period; the paper's reference row in italics.</p>"

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import InterplayError
 from ..io.atomic import atomic_path
+from ..result import strict_json
 from ..systems.shape import Shape
 
 SCENE_FILE = "scene.json"
@@ -24,6 +25,7 @@ QUATERNION_KEYS = ("orientation", "segment_orientations")  # (w, x, y, z), last 
 FRAME_KEYS = ("t", "points", "position", "orientation", "segment_positions",
               "segment_orientations", "heights", "particles")
 FORMAT_VERSION = 1
+FORMS = ("body", "parts", "surface", "cords", "particles", "static")
 
 # linear RGB in 0..1, per palette family (systems/shape.py)
 _PALETTE = {"rigid": [(0.85, 0.38, 0.10), (0.20, 0.45, 0.80), (0.30, 0.65, 0.30)],
@@ -158,39 +160,143 @@ def _derive(frames: dict, shapes) -> dict:
     return frames
 
 
-def write_scene_file(run: RunData, out_dir) -> Path:
+def write_scene_file(run: RunData, out_dir, run_id: str | None = None) -> Path:
     """Write scene.json (shapes and run settings) beside tracks.npz; returns its path."""
     path = Path(out_dir) / SCENE_FILE
-    doc = {"format": FORMAT_VERSION, "scene": run.scene, "coupling": run.coupling,
+    doc = {"format": FORMAT_VERSION, "run_id": run_id, "scene": run.scene,
+           "coupling": run.coupling,
            "fps": run.fps, "duration_s": run.duration, "primary": run.primary,
            "units": "m, s; +z up", "shapes": [s.to_json() for s in run.shapes]}
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(doc))
+        tmp.write_text(strict_json(doc))
     return path
 
 
 def load_run(run_dir) -> RunData:
-    """Read a saved run (scene.json, tracks.npz, summary.json if present) back as RunData."""
+    """Read a saved run (scene.json, tracks.npz, summary.json if present) back as RunData.
+
+    A saved folder is data, never code: tracks.npz is read with ``allow_pickle=False`` and
+    every shape, array, dtype and run id is checked before use (``_check``), so a damaged or
+    hostile folder is one InterplayError naming the file and what is wrong."""
+    from .runfolder import verify
     d = Path(run_dir)
     scene_path, tracks_path = d / SCENE_FILE, d / "tracks.npz"
     for p in (scene_path, tracks_path):
         if not p.is_file():
             raise InterplayError(f"{d}: no {p.name} here; pass the directory `interplay run` "
                                  "or `interplay compare` wrote (e.g. out/basketball/two-way)")
+    manifest = verify(d)
+    doc = _json_file(scene_path)
+    run_id = manifest.get("run_id")
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT_VERSION:
+        raise InterplayError(f"{scene_path}: not a scene file of format {FORMAT_VERSION}; run "
+                             "the scene again")
+    for key, kind in (("scene", str), ("coupling", str), ("fps", float),
+                      ("duration_s", float), ("shapes", list)):
+        v = doc.get(key)
+        ok = isinstance(v, kind) or (kind is float and isinstance(v, int)
+                                     and not isinstance(v, bool))
+        if not ok or (kind is float and not (np.isfinite(v) and v > 0)):
+            raise InterplayError(f"{scene_path}: {key} is missing or not a valid "
+                                 f"{kind.__name__} ({v!r}); run the scene again")
+    shapes = []
+    for i, sd in enumerate(doc["shapes"]):
+        try:
+            sh = Shape.from_json(sd)
+            if not (isinstance(sh.name, str) and sh.form in FORMS and isinstance(sh.palette, str)
+                    and len(sh.color) == 3 and np.isfinite(np.asarray(sh.color, float)).all()
+                    and np.isfinite(sh.width)):
+                raise ValueError("name, form, palette, color or width")
+            shapes.append(sh)
+        except Exception as e:  # noqa: BLE001 - any malformed entry is the same answer
+            raise InterplayError(f"{scene_path}: shape {i} is malformed ({type(e).__name__}: "
+                                 f"{e}); run the scene again") from None
+    if len({sh.name for sh in shapes}) != len(shapes):
+        raise InterplayError(f"{scene_path}: two shapes share a name; run the scene again")
+    frames: dict = {}
     try:
-        doc = json.loads(scene_path.read_text())
-        shapes = [Shape.from_json(s) for s in doc["shapes"]]
-        frames: dict = {}
-        with np.load(tracks_path) as npz:
+        with np.load(tracks_path, allow_pickle=False) as npz:
+            ids = npz["run_id"] if "run_id" in npz.files else None
             for key in npz.files:
                 name, _, field_ = key.rpartition("/")
                 if field_ in FRAME_KEYS:
                     frames.setdefault(name, {})[field_] = npz[key]
-        frames = _derive(frames, shapes)
-    except (ValueError, KeyError, OSError) as e:
-        raise InterplayError(f"{d}: cannot read the saved run ({e}); run it again") from None
-    summary = None
-    if (d / "summary.json").is_file():
-        summary = json.loads((d / "summary.json").read_text())
+    except Exception as e:  # noqa: BLE001 - zip, zlib, format and pickle refusals alike
+        raise InterplayError(f"{tracks_path}: cannot read the saved run ({type(e).__name__}: "
+                             f"{e}); run it again") from None
+    summary = _json_file(d / "summary.json") if (d / "summary.json").is_file() else None
+    # the manifest's id, else scene.json's: every file of the folder must carry it
+    run_id = run_id or doc.get("run_id")
+    for what, rid in (("scene.json", doc.get("run_id")),
+                      ("tracks.npz", None if ids is None else str(ids)),
+                      ("summary.json", summary.get("run_id", run_id)
+                       if isinstance(summary, dict) else run_id)):
+        if run_id is not None and rid != run_id:
+            raise InterplayError(f"{d}: {what} belongs to run {rid}, not to run {run_id} (a "
+                                 "folder mixing two runs); run the scene again")
+    _check(frames, shapes, tracks_path)
+    frames = _derive(frames, shapes)
     return RunData(doc["scene"], doc["coupling"], float(doc["fps"]), float(doc["duration_s"]),
                    shapes, frames, doc.get("primary"), summary)
+
+
+def _json_file(path: Path):
+    try:
+        return json.loads(path.read_text())
+    except (ValueError, OSError, UnicodeDecodeError) as e:
+        raise InterplayError(f"{path}: damaged JSON ({e}); run the scene again") from None
+
+
+# the trailing shape of each frame array, from the shape it draws (None: any length)
+def _expected(key, shape):
+    n = None if shape is None else (
+        len(shape.verts) if shape.verts is not None and shape.form in ("surface", "cords")
+        else None)
+    parts = None if shape is None or shape.parts is None else len(shape.parts)
+    return {"t": (), "position": (3,), "orientation": (4,), "points": (n, 3),
+            "segment_positions": (parts, 3), "segment_orientations": (parts, 4),
+            "heights": (None if shape is None or shape.grid_xy is None else len(shape.grid_xy),),
+            "particles": (None, 3)}[key]
+
+
+def _check(frames: dict, shapes, path):
+    """Every frame array a float array of the shape its system's Shape implies, the same
+    number of frames per system, times finite and increasing, values finite (absent spray
+    particles are whole NaN rows)."""
+    by_name = {sh.name: sh for sh in shapes}
+    for sh in shapes:
+        if sh.animated and sh.source is None:
+            need = {"body": ("position", "orientation"),
+                    "parts": ("segment_positions", "segment_orientations"),
+                    "surface": ("heights",) if sh.grid_xy is not None else ("points",),
+                    "cords": ("points",)}.get(sh.form, ())
+            missing = [k for k in ("t", *need) if k not in frames.get(sh.name, {})]
+            if missing:
+                raise InterplayError(f"{path}: no {', '.join(missing)} frames for {sh.name}; "
+                                     "run the scene again")
+    for name, fr in frames.items():
+        t = fr.get("t")
+        if t is None or t.ndim != 1 or len(t) == 0:
+            raise InterplayError(f"{path}: {name}/t is missing or not a list of times")
+        for key, a in fr.items():
+            want = _expected(key, by_name.get(name))
+            if a.dtype.kind != "f" or a.ndim != 1 + len(want) or len(a) != len(t) or any(
+                    w is not None and g != w for g, w in zip(a.shape[1:], want)):
+                raise InterplayError(f"{path}: {name}/{key} has shape {a.shape} and dtype "
+                                     f"{a.dtype}; expected ({len(t)}, "
+                                     f"{', '.join('n' if w is None else str(w) for w in want)})"
+                                     " floats; run the scene again")
+            sh = by_name.get(name)
+            idx = None if sh is None else (sh.triangles if sh.triangles is not None
+                                           else sh.segments)
+            if key == "points" and idx is not None and len(idx) and a.shape[1] <= idx.max():
+                raise InterplayError(f"{path}: {name}/points has {a.shape[1]} points but its "
+                                     f"shape uses point {int(idx.max())}; run the scene again")
+            ok = np.isfinite(a)
+            if key == "particles":
+                ok = ok.all(-1) | np.isnan(a).all(-1)
+            if not ok.all():
+                raise InterplayError(f"{path}: {name}/{key} holds NaN or inf; run the scene "
+                                     "again")
+        if np.any(np.diff(t) <= 0):
+            raise InterplayError(f"{path}: {name}/t does not increase; run the scene again")

@@ -4,7 +4,7 @@
   summary.json, tracks.npz   (Result.save)
   scene.json                 shapes for redrawing (the web viewer reads it)
   run.usdc | run.usda        the USD stage
-  obj/                       OBJ sequences
+  obj/                       OBJ sequences (opt-in: OutputOptions.obj, --obj)
   preview.mp4                the preview video
   report.html + plot_*.png   the run report
 ``write_compare_outputs`` adds, above the per-mode folders of ``interplay compare``, the
@@ -28,11 +28,11 @@ class OutputOptions:
     (sampled by time from the run's frames); camera: None frames every system."""
     usd: bool = True
     usd_format: str = "usdc"
-    obj: bool = True
+    obj: bool = False  # OBJ sequences are opt-in (--obj): a file per frame per system
     video: bool = True
     report: bool = True
-    size: tuple = (1280, 720)
-    video_fps: float = 30.0
+    size: tuple = (960, 540)  # px: a preview that renders beside the other outputs
+    video_fps: float = 24.0  # frames/s: animation's rate
     camera: Camera | None = None
     quiet: bool = False
     timings: dict = field(default_factory=dict, compare=False)
@@ -58,14 +58,22 @@ def preflight(out_dir, options: OutputOptions) -> Path:
     requested output's dependencies importable (and a headless GL context available for the
     video). Each failure is one InterplayError naming the fix."""
     d = ensure_writable(out_dir)
+    worker = None
+    if options.video:
+        # first, before any thread or GL context: the renderer's own process checks GL
+        from .render import worker as render_worker
+        worker = render_worker.start()
     if options.usd:
         from .usd import _pxr
         _pxr()
     if options.video:
-        from .render.gl import gl_context
-        from .render.video import _ffmpeg
-        gl_context()
-        _ffmpeg()
+        if worker is not None:
+            worker.ready()
+        else:
+            from .render.gl import gl_context
+            from .render.video import _ffmpeg
+            gl_context()
+            _ffmpeg()
     if options.report:
         from .render.plots import _figure
         _figure(1, 1)
@@ -106,22 +114,51 @@ def _timed(timings, key, fn, *args, **kw):
 
 
 def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
-                  summary: dict | None = None) -> list[Path]:
-    """Write every output of one run into out_dir; return the paths, in order.
+                  summary: dict | None = None, run_id: str | None = None,
+                  request: dict | None = None, locked: bool = False) -> list[Path]:
+    """Write every output of one run into out_dir as one unit (outputs/runfolder.py: staged,
+    then published under a manifest with the run id); return the final paths, in order.
 
     summary: the dict to save as summary.json (default ``result.summary()``). Wall times of
-    each output land in ``options.timings`` (s): usd_s, obj_s, video_render_s,
-    video_encode_s, report_s.
+    each output land in ``options.timings`` (s): save_s (summary, tracks, scene.json), usd_s,
+    obj_s, plots_s, video_render_s and video_encode_s (inside the renderer), video_wait_s
+    (how long the rest waited for a preview rendering in its own process), report_s.
+    The preview renders in the process ``preflight`` started, while the USD, OBJ and plots
+    are written here. run_id: the run's id (a new one by default); request: what was asked
+    for, kept in the manifest; locked: the caller holds out_dir's runfolder.Lock.
     """
+    from contextlib import nullcontext
+
+    from . import runfolder
+    final = ensure_writable(out_dir)
+    run_id = run_id or runfolder.new_run_id()
+    with nullcontext() if locked else runfolder.Lock(final):
+        if not locked:
+            runfolder.claim(final)
+        staging = final / f".staging-{run_id}"
+        staging.mkdir(exist_ok=True)
+        paths = _write_all(result, staging, options, summary, run_id)
+        runfolder.publish(final, staging, run_id, request)
+    return [final / p.relative_to(staging) for p in paths]
+
+
+def _write_all(result, out, options, summary, run_id) -> list[Path]:
     from .rundata import from_result, write_scene_file
-    out = ensure_writable(out_dir)
-    summary = summary if summary is not None else result.summary()
+    summary = dict(summary if summary is not None else result.summary(), run_id=run_id)
     run = from_result(result)
     tm = options.timings
-    paths = list(result.save(out, summary))
+    t0 = time.perf_counter()
+    paths = list(result.save(out, summary, run_id))
     files = {"summary (JSON)": paths[0], "tracks (NumPy npz)": paths[1]}
-    paths.append(write_scene_file(run, out))
+    paths.append(write_scene_file(run, out, run_id))
+    tm["save_s"] = time.perf_counter() - t0
     files["shapes for the viewer"] = paths[-1]
+    video = st = None
+    from .render import worker as render_worker
+    worker = render_worker.current() if options.video else None
+    if worker is not None:  # the preview renders in its own process while the rest is written
+        worker.submit({run.scene: out}, out / "preview.mp4", options.size, options.video_fps,
+                      options.camera)
     if options.usd:
         from .usd import write_usd
         p = _timed(tm, "usd_s", write_usd, run, out / f"run.{options.usd_format}",
@@ -134,21 +171,30 @@ def write_outputs(result, out_dir, options: OutputOptions = OutputOptions(),
                StepBar("OBJ sequence", options.quiet))
         paths.append(out / "obj")
         files["OBJ sequences (one file per frame)"] = out / "obj"
-    video = st = None
+    plots = None
+    if options.report:
+        from .report import force_plots
+        plots = _timed(tm, "plots_s", force_plots, result, out, summary)
     if options.video:
-        from .render.video import render_video
-        st = render_video(run, out / "preview.mp4", options.size, options.video_fps,
-                          options.camera, StepBar("rendering preview.mp4", options.quiet))
+        bar = StepBar("rendering preview.mp4", options.quiet)
+        t0 = time.perf_counter()
+        if worker is not None:
+            st = worker.result(bar)
+            tm["video_wait_s"] = time.perf_counter() - t0
+        else:
+            from .render.video import render_video
+            st = render_video(run, out / "preview.mp4", options.size, options.video_fps,
+                              options.camera, bar)
         tm.update({"video_render_s": st["render_s"], "video_encode_s": st["encode_s"],
                    "video_frames": st["frames"]})
-        video = st["path"]
+        video = Path(st["path"])
         paths.append(video)
         files["preview video (H.264)"] = video
     if options.report:
         from .report import write_run_report
         shown = {k: v for k, v in tm.items() if k.endswith("_s")}
         written = _timed(tm, "report_s", write_run_report, result, out, summary, files, video,
-                         shown, st)
+                         shown, st, plots)
         paths += written  # the plots, then report.html
     return paths
 
@@ -163,18 +209,25 @@ def write_compare_outputs(results: dict, out_dir, rows: dict, advice: dict,
     runs = {m: from_result(r) for m, r in results.items()}
     paths = []
     video = st = None
+    mode_dirs = mode_dirs or {m: out / m for m in results}
     if options.video:
+        from .render import worker as render_worker
         from .render.video import render_side_by_side
-        st = render_side_by_side(runs, out / "compare.mp4", options.size, options.video_fps,
-                                 options.camera,
-                                 StepBar("rendering compare.mp4", options.quiet))
+        bar = StepBar("rendering compare.mp4", options.quiet)
+        worker = render_worker.current()
+        if worker is not None and all((d / "tracks.npz").is_file() for d in mode_dirs.values()):
+            worker.submit(mode_dirs, out / "compare.mp4", options.size, options.video_fps,
+                          options.camera, panels=True)
+            st = worker.result(bar)
+        else:
+            st = render_side_by_side(runs, out / "compare.mp4", options.size, options.video_fps,
+                                     options.camera, bar)
+        video = Path(st["path"])
         options.timings.update({"compare_render_s": st["render_s"],
                                 "compare_encode_s": st["encode_s"]})
-        video = st["path"]
         paths.append(video)
     if options.report:
         from .report import write_compare_report
-        mode_dirs = mode_dirs or {m: out / m for m in results}
         reports = {m: d / "report.html" for m, d in mode_dirs.items()
                    if (d / "report.html").exists()}
         files = {"compare.json": out / "compare.json"} if (out / "compare.json").exists() else {}

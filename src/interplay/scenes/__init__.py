@@ -6,7 +6,7 @@ import importlib
 from ..errors import SceneError
 
 #: the scene modules, loaded on demand (a scene's module imports its systems)
-MODULES = ("basketball", "bungee", "flags", "leaves", "pond", "puddle", "trampoline")
+MODULES = ("basketball", "bungee", "diver", "flags", "leaves", "pond", "puddle", "trampoline")
 
 
 def spec(name: str):

@@ -19,12 +19,17 @@ import numpy as np
 from ..control import behaviours as B
 from ..control.fsm import Controller, State, Transition
 from ..geometry.anthropometry import SEGMENTS, BodyParams
+from ..geometry.setpieces import bridge
 from ..interactions.attachment import AttachmentParams, SegmentAttachment
+from ..outputs.render.camera import TrackingCamera
 from ..scene import Scene
+from ..systems.colliders import set_pieces
 from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
+from ..systems.static import StaticPlane
 from .contract import SceneSpec
+from ..params import param
 
 BRIDGE = 40.0  # m, the platform's top
 EDGE = 0.0  # m, x of the platform's front edge (the jumper faces +x)
@@ -34,6 +39,8 @@ STRAP_STIFFNESS = 2.0e4  # N/m, each strap (webbing: stiff beside the cord)
 TIP_MAX = 1.5  # s: the leap starts by then even if the lean never gets far enough
 STRAIN_LIMIT = 3.0  # a bungee cord is made to stretch (15 m to ~26 m at the bottom here)
 ANCHOR_HEIGHT = 0.5  # m above the deck: the jump arm the cord hangs from
+PLATFORM = (-3.0, EDGE, -1.5, 1.5)  # m: x0, x1, y0, y1 of the jump platform's top
+CORD_RADIUS = 0.016  # m: a jumper's bungee, a bundle of latex strands ~3 cm across
 
 
 @dataclass(frozen=True)
@@ -47,14 +54,15 @@ class CordParams:
     frequency, where an elastic pendulum pumps its bounce into a growing swing; 250 N/m keeps
     the 64 kg jumper well clear of it (k L0 / m g = 5.9). Damping 0.05 s gives the bounce a
     damping ratio of about 0.05 (k beta / 2 sqrt(k m)), a rubber cord's hysteresis."""
-    enabled: bool = True
-    length: float = 15.0  # m
-    stiffness: float = 250.0  # N/m, whole cord: its n-1 springs in series
-    mass: float = 1.0  # kg
-    points: int = 21
-    damping: float = 0.05  # s
-    dt: float = 1e-3  # s
-    reach: float = 1.8  # m
+    enabled: bool = param(True, doc="false: the jumper alone (leap tuning)")
+    length: float = param(15.0, "m", ge=0.1, le=1000.0, doc="rest length")
+    # whole cord: its n-1 springs in series
+    stiffness: float = param(250.0, "N/m", ge=1e-3, le=1e7, doc="the whole cord's")
+    mass: float = param(1.0, "kg", ge=1e-3, le=1000.0)
+    points: int = param(21, "points", ge=3, le=10_000, cost="points")
+    damping: float = param(0.05, "s", ge=0.0, le=10.0, doc="stiffness-proportional")
+    dt: float = param(1e-3, "s", ge=1e-9, le=0.1)
+    reach: float = param(1.8, "m", ge=0.0, le=100.0, doc="anchor past the deck's edge")
 
 
 @dataclass(frozen=True)
@@ -66,18 +74,18 @@ class JumperParams:
     hip (rad of hip flexion it extends to: a forward dive), power (-, scales the extension's
     velocity targets), arm_swing (rad of shoulder flexion the arms swing to); tuck (s) the knees
     are pulled up after takeoff so the feet clear the edge, before the layout."""
-    mass: float = 64.38  # kg
-    height: float = 1.70  # m
-    stand: float = 0.3  # s
-    crouch: float = 0.7  # s
-    depth: float = 0.65
-    lean: float = 0.36  # rad
-    lead: float = 0.16  # m
-    tip_ankle: float = 0.52  # rad
-    hip: float = 0.67  # rad
-    power: float = 1.24
-    arm_swing: float = 1.00  # rad
-    tuck: float = 0.75  # s
+    mass: float = param(64.38, "kg", ge=10.0, le=500.0)
+    height: float = param(1.70, "m", ge=0.5, le=3.0)
+    stand: float = param(0.3, "s", ge=0.0, le=100.0)
+    crouch: float = param(0.7, "s", ge=0.0, le=100.0)
+    depth: float = param(0.65, "-", ge=0.0, le=2.0, doc="crouch depth, 1 = deep")
+    lean: float = param(0.36, "rad", ge=-1.6, le=1.6, doc="trunk lean in the crouch")
+    lead: float = param(0.16, "m", ge=-1.0, le=1.0, doc="centre of mass ahead of the feet")
+    tip_ankle: float = param(0.52, "rad", ge=-1.6, le=1.6, doc="ankle dorsiflexion to tip")
+    hip: float = param(0.67, "rad", ge=-1.6, le=2.6, doc="hip flexion of the push")
+    power: float = param(1.24, "-", ge=0.0, le=5.0, doc="scales the extension's velocities")
+    arm_swing: float = param(1.00, "rad", ge=-3.2, le=3.2, doc="shoulder flexion of the swing")
+    tuck: float = param(0.75, "s", ge=0.0, le=100.0, doc="knees pulled up after takeoff")
 
 
 @dataclass(frozen=True)
@@ -86,8 +94,8 @@ class BungeeParams:
     jumper: JumperParams = JumperParams()
     cord: CordParams = CordParams()
     tie: AttachmentParams = AttachmentParams()
-    coupling_dt: float = 1e-3  # s
-    air_density: float = 1.2  # kg/m^3
+    coupling_dt: float = param(1e-3, "s", ge=1e-7, le=0.1)
+    air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0, doc="0: no drag")
 
 
 def controller(p: JumperParams) -> Controller:
@@ -106,7 +114,7 @@ def controller(p: JumperParams) -> Controller:
 
 def jumper(p: JumperParams, air_density: float = 1.2) -> Figure:
     """The jumper on the bridge platform, under his leap controller; air_density (kg/m^3)."""
-    env = EnvironmentParams(floor=None, platform=(-3.0, EDGE, -1.5, 1.5, BRIDGE),
+    env = EnvironmentParams(floor=None, platform=(*PLATFORM, BRIDGE),
                             air_density=air_density)
     return Figure("jumper", FigureParams(body=BodyParams(p.mass, p.height), environment=env,
                                          position=(STANCE_X, 0.0, BRIDGE)), controller(p))
@@ -132,7 +140,8 @@ def cord(c: CordParams, anchor, ankles, integrator="implicit", dt=None) -> Sprin
                       np.ones(n + 1, dtype=bool))
     net = SpringNetwork("cord", x, c.mass / (n + 2), springs, dt=dt or c.dt, integrator=integrator,
                         stiffness_damping=c.damping, fixed=[0, n, n + 1],
-                        strain_limit=STRAIN_LIMIT)
+                        strain_limit=STRAIN_LIMIT, cord_radius=CORD_RADIUS,
+                        color=(0.95, 0.75, 0.10))
     net.settle(1.0)
     net.fixed[[n, n + 1]] = False  # the straps move with the ankles from here on
     return net
@@ -145,11 +154,16 @@ def build(coupling: str = "two-way", duration: float = 8.0, fps: float = 30.0,
     scene = Scene("bungee", duration=duration, fps=fps, coupling_dt=params.coupling_dt)
     fig = scene.add(jumper(params.jumper, params.air_density))
     scene.primary = fig
+    anchor = [EDGE + c.reach, 0.0, BRIDGE + ANCHOR_HEIGHT]
+    # the bridge he leaps from: its deck, the platform (the figure's own collision model
+    # holds it), the jump arm the cord hangs from, and the valley floor far below
+    for piece in set_pieces(bridge(BRIDGE, EDGE, PLATFORM, anchor)):
+        scene.add(piece)
+    scene.add(StaticPlane("valley", height=0.0, size=80.0, color=(0.28, 0.40, 0.20)))
     if c.enabled:
         feet = ("l_foot", "r_foot")
         ankles = fig.contact_view().poses()[0][[SEGMENTS.index(f) for f in feet]]
-        net = scene.add(cord(c, [EDGE + c.reach, 0.0, BRIDGE + ANCHOR_HEIGHT], ankles,
-                             integrator or "implicit", dt))
+        net = scene.add(cord(c, anchor, ankles, integrator or "implicit", dt))
         n = c.points
         scene.connect(SegmentAttachment("cord", fig, net, ((n, feet[0]), (n + 1, feet[1])),
                                         params=params.tie, mode=coupling))
@@ -214,7 +228,10 @@ def tune_leap(evaluations: int = 150, seed: int = 0, start: JumperParams = Jumpe
 SPEC = SceneSpec(
     "bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)", build,
     BungeeParams, couplings=("two-way", "one-way"), duration=8.0, fps=30.0,
-    integrators=("explicit", "implicit", "localglobal"))
+    integrators=("explicit", "implicit", "localglobal"),
+    # beside him and a little above, 6.7 m off: he stays a third of the frame tall all the way
+    camera=TrackingCamera("jumper", offset=(5.2, -4.0, 1.2), target_offset=(0.4, 0.0, -0.3),
+                          fov_deg=38.0, smooth_s=0.35), key_time=3.4)
 
 
 if __name__ == "__main__":

@@ -19,10 +19,12 @@ class SceneSpec:
     integrators: the ``--integrator`` values that apply (empty: none does, e.g. the water has
     one); standin: the params field holding its hybrid stand-in's coefficients when
     ``interplay fit-standin`` can fit them, with fit_time (s): the time at which the
-    primary's velocity is matched; camera: its default preview camera (None: frame every
-    system); figures: result -> {label: value}, the scene's own key figures (the basketball's
-    exit speed) for summaries and compare tables; tune: its controller search
-    (control/search.TuneProblem) for ``interplay tune``, None for none.
+    primary's velocity is matched; camera: its default preview camera (an
+    outputs.render.camera Camera or TrackingCamera; None: frame every system); key_time (s):
+    the moment its figure shows (the ball in the net), the gallery's still; figures: result ->
+    {label: value}, the scene's own key figures (the basketball's exit speed) for summaries
+    and compare tables; tune: its controller search (control/search.TuneProblem) for
+    ``interplay tune``, None for none.
     """
     name: str
     description: str
@@ -35,6 +37,7 @@ class SceneSpec:
     standin: str | None = None
     fit_time: float | None = None
     camera: object = None
+    key_time: float | None = None
     figures: Callable | None = field(default=None, compare=False)
     tune: object = field(default=None, compare=False)
 

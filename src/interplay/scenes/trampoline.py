@@ -38,6 +38,7 @@ from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from ..systems.springmass import SpringNetwork, Springs
 from ..systems.static import StaticPlane
+from ..params import param
 from .contract import SceneSpec
 
 from ..errors import StabilityError
@@ -52,10 +53,10 @@ class GymnastParams:
     """The gymnast: mass (kg), height (m) (the paper's Table I gymnast: 64.38 kg); drop (m):
     her soles' height above the bed at the start (dropped from rest at her first apex);
     air_density (kg/m^3) of the drag on her segments."""
-    mass: float = 64.38  # kg
-    height: float = 1.70  # m
-    drop: float = 1.0  # m
-    air_density: float = 1.2  # kg/m^3
+    mass: float = param(64.38, "kg", ge=10.0, le=500.0)
+    height: float = param(1.70, "m", ge=0.5, le=3.0)
+    drop: float = param(1.0, "m", ge=0.0, le=10.0, doc="soles above the bed at the start")
+    air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
 
 
 @dataclass(frozen=True)
@@ -67,7 +68,7 @@ class TrampolineParams:
     bounce: BounceParams = BounceParams()
     contact: PartContactParams = PartContactParams()
     standin: BedSpringsParams = BedSpringsParams()
-    coupling_dt: float = 1e-3  # s
+    coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
 
 
 def bed(p: BedParams, integrator: str = "explicit", dt: float | None = None) -> SpringNetwork:

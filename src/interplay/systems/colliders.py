@@ -31,9 +31,10 @@ def box_surface(half):
 
 class StaticShape(Stateless):
     """Base of immovable colliders: mass inf, no state, never stepped. color: linear RGB
-    (0..1) as drawn, None for the outputs' default."""
+    (0..1) as drawn, None for the outputs' default; material: as drawn (systems/shape.py)."""
 
     color = None
+    material = "matte"
 
     def contact_view(self):
         return ShapeView(self, self.distance)
@@ -41,7 +42,7 @@ class StaticShape(Stateless):
     def shapes(self):
         v, t = self.surface()
         return [Shape(self.name, "static", color=self.color, verts=np.asarray(v, float),
-                      tris=np.asarray(t), palette="static")]
+                      tris=np.asarray(t), palette="static", material=self.material)]
 
     def distance(self, points):
         """Signed distance (n,) m and outward unit normals (n,3) of points (n,3)."""
@@ -110,10 +111,12 @@ class StaticSphere(StaticCapsule):
 
 class StaticMesh(StaticShape):
     """A triangle mesh (vertices m, triangles wound outward). Points behind a face, down to
-    ``depth`` (m), are inside (a closed mesh, or the solid side of a terrain)."""
+    ``depth`` (m), are inside (a closed mesh, or the solid side of a terrain). A set piece
+    (a pole, a rim, a deck) is one: color and material are how it is drawn."""
 
-    def __init__(self, name, vertices, triangles, depth=0.05):
+    def __init__(self, name, vertices, triangles, depth=0.05, color=None, material="matte"):
         super().__init__(name)
+        self.color, self.material = color, material
         self.depth = require_positive(name, "depth", depth, "m")
         self.tree = AABBTree(vertices, triangles, owner=name)
         self.vertices, self.triangles = self.tree.x, self.tree.elements
@@ -130,3 +133,10 @@ class StaticMesh(StaticShape):
 
     def surface(self):
         return self.vertices, self.triangles
+
+
+def set_pieces(pieces) -> list:
+    """StaticMesh systems of geometry.setpieces Pieces (drawn and exported; collidable where
+    a scene connects a contact)."""
+    return [StaticMesh(p.name, p.verts, p.tris, color=p.color, material=p.material)
+            for p in pieces]

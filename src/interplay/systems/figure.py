@@ -20,11 +20,12 @@ from ..control.fsm import Controller, StateMachine
 from ..control.gravity import GravityCompensation
 from ..control.pd import axis_inertias, pd_gains
 from ..errors import ParameterError, require_positive
+from ..params import param
 from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, joint_names,
                                       segment_mesh, segment_primitive)
 from .base import System, substeps
 from .figure_model import AirDrag, EnvironmentParams, build_model, geom_extents, joint_group
-from .shape import Shape
+from .shape import figure_shape
 from .views import BodiesView, RigidParts
 
 LEG_GROUPS = ("hip", "knee", "ankle", "toe")
@@ -48,13 +49,13 @@ class FigureParams:
     gravity (control/gravity.py) to the servo law."""
     body: BodyParams = BodyParams()
     environment: EnvironmentParams = EnvironmentParams()
-    position: tuple = (0.0, 0.0, 0.0)  # m
-    yaw: float = 0.0  # rad
-    dt: float = 1e-3  # s
-    control_dt: float = 5e-3  # s
-    omega: float = 20.0  # rad/s
-    zeta: float = 1.0
-    support_omega: float = 8.0  # rad/s
+    position: tuple = param((0.0, 0.0, 0.0), "m", ge=-1e4, le=1e4)
+    yaw: float = param(0.0, "rad", ge=-100.0, le=100.0)
+    dt: float = param(1e-3, "s", ge=1e-7, le=0.01)
+    control_dt: float = param(5e-3, "s", ge=1e-5, le=0.1)
+    omega: float = param(20.0, "rad/s", gt=0.0, le=1e3)
+    zeta: float = param(1.0, "-", gt=0.0, le=10.0)
+    support_omega: float = param(8.0, "rad/s", gt=0.0, le=1e3)
     gravity_compensation: bool = True
 
 
@@ -256,8 +257,10 @@ class Figure(System, RigidParts):
         self.apply_gains()
 
     def sensors(self) -> dict:
-        """What transitions read: foot/hand contact, centre of mass (m), its velocity (m/s) and
-        how far (m) it is ahead of the middle of the feet along the facing direction."""
+        """What transitions read: foot/hand contact, centre of mass (m), its velocity (m/s),
+        how far (m) it is ahead of the middle of the feet along the facing direction, and the
+        trunk's pitch (rad): how far its up axis has turned forward from vertical about the
+        starting left-right axis (-pi..pi; pi is head down), and its rate (rad/s)."""
         d, m = self.data, self.model
         geoms = d.contact.geom[:d.ncon]
         self._mj.mj_subtreeVel(m, d)
@@ -267,7 +270,22 @@ class Figure(System, RigidParts):
                 "hand_contact": bool(self._geom_hand[geoms].any() or hands),
                 "com": com, "com_vel": d.subtree_linvel[self.root].copy(),
                 "com_ahead": float(np.dot(com - d.geom_xpos[self.sole_geoms].mean(axis=0),
-                                          self._forward()))}
+                                          self._forward())),
+                "pitch": self.pitch(), "pitch_rate": self.pitch_rate()}
+
+    def pitch_rate(self) -> float:
+        """The trunk's forward pitch rate (rad/s): its angular velocity about the starting
+        left-right axis."""
+        w = self.part_velocities([SEGMENTS.index("torso")])[1][0]
+        yaw = self.params.yaw
+        return float(-w[0] * math.sin(yaw) + w[1] * math.cos(yaw))
+
+    def pitch(self) -> float:
+        """The trunk's forward pitch (rad, -pi..pi): the angle of its up axis from vertical,
+        positive towards the heading the figure started with (its yaw)."""
+        up = self.data.xmat[self.seg_body[SEGMENTS.index("torso")]].reshape(3, 3)[:, 2]
+        yaw = self.params.yaw
+        return math.atan2(up[0] * math.cos(yaw) + up[1] * math.sin(yaw), up[2])
 
     def _forward(self) -> np.ndarray:
         """The pelvis's facing direction in the horizontal plane (unit)."""
@@ -519,9 +537,7 @@ class Figure(System, RigidParts):
         self.add_wrench(force, torque, point, body=int(part))
 
     def shapes(self):
-        return [Shape(self.name, "parts", color=self.color,
-                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
-                             for v, t in self.segment_meshes()])]
+        return [figure_shape(self.name, self.plan, self.color)]
 
     # --- geometry ----------------------------------------------------------------------------
     def segment_meshes(self) -> list:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..params import param
 from ..geometry.anthropometry import Segment
 
 # Peak joint torques (N m) of a 75 kg adult, scaled with body mass; sagittal leg values are of
@@ -28,10 +29,11 @@ class EnvironmentParams:
     (x_min, x_max, y_min, y_max, top) m of a static deck whose top face is at z = top, () for
     none; friction: Coulomb coefficient of the feet on them (-); air_density (kg/m^3): 0 for
     none, else quadratic drag on each segment's equivalent inertia box (``AirDrag``; air 1.2)."""
-    floor: float | None = 0.0  # m
-    platform: tuple = ()  # m
-    friction: float = 1.0
-    air_density: float = 0.0  # kg/m^3
+    floor: float | None = param(0.0, "m", ge=-1e4, le=1e4, doc="ground height, none: no ground")
+    platform: tuple = param((), "m", ge=-1e4, le=1e4, length=(0, 5),
+                            doc="x_min, x_max, y_min, y_max, top of a deck, or empty")
+    friction: float = param(1.0, "-", ge=0.0, le=10.0)
+    air_density: float = param(0.0, "kg/m^3", ge=0.0, le=100.0)
 
 
 def joint_group(name: str) -> str:

@@ -3,12 +3,12 @@ forces. Nothing pushes back on them, so they are primaries of one-way interactio
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError, require_positive
-from ..params import ANY_LENGTH
+from ..params import param
 from ..geometry.primitive import Primitive
 from ..geometry.sphere import icosphere
 from .base import Role, System
@@ -22,12 +22,22 @@ class KeyframedBodyParams:
     semi_axes (m) of its ellipsoid shape in the body frame (x forward); yaw (rad) about +z;
     mass (kg: what the analysis divides interaction forces by); dt (s): its step (any step is
     exact: the path is a function of time)."""
-    times: tuple = field(default=(0.0, 1.0), metadata=ANY_LENGTH)
-    positions: tuple = field(default=(0.0, 0.0, 0.0, 1.0, 0.0, 0.0), metadata=ANY_LENGTH)
-    semi_axes: tuple = (0.13, 0.05, 0.045)  # m
-    yaw: float = 0.0  # rad
-    mass: float = 1.1  # kg
-    dt: float = 0.01  # s
+    times: tuple = param((0.0, 1.0), "s", ge=0.0, le=1e5, length=None,
+                         doc="key times, increasing")
+    positions: tuple = param((0.0, 0.0, 0.0, 1.0, 0.0, 0.0), "m", ge=-1e4, le=1e4, length=None,
+                             doc="x, y, z of each key")
+    semi_axes: tuple = param((0.13, 0.05, 0.045), "m", ge=1e-3, le=10.0)
+    yaw: float = param(0.0, "rad", ge=-100.0, le=100.0)
+    mass: float = param(1.1, "kg", ge=1e-3, le=1e4)
+    dt: float = param(0.01, "s", ge=1e-9, le=1.0)
+
+    def __post_init__(self):
+        t = self.times
+        if len(t) < 2 or any(b <= a for a, b in zip(t, t[1:])):
+            raise ParameterError(f"key times must increase strictly (at least 2 keys), got {t}")
+        if len(self.positions) != 3 * len(t):
+            raise ParameterError(f"positions must hold x, y, z for each of the {len(t)} keys "
+                                 f"({3 * len(t)} numbers), got {len(self.positions)}")
 
 
 class KeyframedBody(System, RigidParts):

@@ -18,10 +18,10 @@ import numpy as np
 from ..errors import ParameterError
 from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, segment_mesh,
                                       segment_primitive)
-from ..io.motion_file import BVHError, Motion, read_bvh
+from ..io.motion_file import BVHError, Motion, check_file, read_bvh
 from ..kernels.rigid import quat_mul
 from .base import Role, System
-from .shape import Shape
+from .shape import figure_shape
 from .views import BodiesView, RigidParts
 
 # segment -> (candidate joint names, candidate names of the joint ending its bone)
@@ -73,16 +73,42 @@ def _quats(R) -> np.ndarray:
     return np.roll(q, 1, axis=-1).reshape(R.shape[:-2] + (4,))
 
 
+TPOSE_JUMP = 5.0  # deg (RMS over the joints): a first frame this far from the second ...
+TPOSE_RATIO = 5.0  # ... and this many times the next frame-to-frame changes is no motion
+STANCE_SPEED = 0.8  # m/s: a foot whose ankle or toe joint is slower than this ...
+STANCE_SINK = 0.3  # m/s: ... whose sole moves up or down slower than this ...
+STANCE_RISE = 0.05  # m: ... and is within this of its lowest around then, stands
+
+
+def tpose_first(motion: Motion) -> bool:
+    """Whether frame 0 is a calibration pose (the T-pose the CMU conversions put first) rather
+    than motion: its joint rotations jump to frame 1 by more than TPOSE_JUMP degrees (root
+    mean square over the rotation channels) and by TPOSE_RATIO times the largest such change
+    over the next ten frames. (The clips here: 28, 31 and 16 deg against at most 2.4, 0.05
+    and 0.1 for the three with a T-pose; 0.8 against 0.9 for the two without.)"""
+    f = motion.frames
+    if len(f) < 4:
+        return False
+    rot = [j.first + c for j in motion.joints for c, ch in enumerate(j.channels)
+           if ch.endswith("rotation")]
+    change = np.abs(np.diff(f[: min(len(f), 12), rot], axis=0))
+    change = np.sqrt(np.mean(np.minimum(change, 360.0 - change) ** 2, axis=1))  # deg
+    return bool(change[0] > TPOSE_JUMP and change[0] > TPOSE_RATIO * change[1:].max())
+
+
 class MocapFigure(System, RigidParts):
     """A figure that plays a retargeted BVH clip. mass (kg) is what the analysis divides
     interaction forces by; units: one of UNITS or None to detect; skip_tpose: drop a first
-    frame whose rotations are all zero (the T-pose the cgspeed conversion adds)."""
+    frame that is a calibration pose, not motion (``tpose_first``: the CMU clips have one);
+    position_offset (m): where the clip is placed; ground: None, a height (m) or a function
+    height(x, y) -> z (m) of the terrain: the clip is then lifted or lowered, stance by stance,
+    so that each standing foot's sole rests on it (``plant``), easing between stances."""
 
     role = Role.PRESCRIBED
     integrator = "retargeted BVH clip, cubic spline playback"
 
     def __init__(self, name: str, path, mass: float = 75.0, units: str | None = None,
-                 skip_tpose: bool = True, position_offset=(0.0, 0.0, 0.0)):
+                 skip_tpose: bool = True, position_offset=(0.0, 0.0, 0.0), ground=None):
         motion = read_bvh(path)
         super().__init__(name, motion.frame_time)
         if units is not None and units not in UNITS:
@@ -100,12 +126,9 @@ class MocapFigure(System, RigidParts):
         scale = UNITS[units] if units else min(
             UNITS.values(), key=lambda u: abs(np.log(sum(legs) * u / TYPICAL_LEG)))
         self.units = units or next(k for k, v in UNITS.items() if v == scale)
-        frames = motion.frames
-        if skip_tpose and len(frames) > 1:
-            rot_cols = [j.first + c for j in motion.joints for c, ch in enumerate(j.channels)
-                        if ch.endswith("rotation")]
-            if np.all(frames[0, rot_cols] == 0.0):
-                motion.frames = frames[1:]
+        self.skipped_tpose = bool(skip_tpose and tpose_first(motion))
+        if self.skipped_tpose:
+            motion.frames = motion.frames[1:]
         hip = (rest[idx["l_thigh"]] - rest[idx["pelvis"]]) * scale @ C.T
         H = (legs[0] + legs[1]) * scale / 0.491  # thigh + shank = 0.491 of standing height
         self.body = BodyParams(mass=mass, height=float(np.clip(H, 0.5, 3.0)),
@@ -134,6 +157,10 @@ class MocapFigure(System, RigidParts):
             else:
                 p = SEGMENTS.index(seg.parent)
                 seg_pos[:, k] = seg_pos[:, p] + seg_rot[:, p] @ seg.offset
+        self.plant_offsets = np.zeros(F)
+        if ground is not None:
+            self.plant_offsets = self.plant(seg_pos, seg_rot, motion.frame_time, ground)
+            seg_pos[:, :, 2] += self.plant_offsets[:, None]
         q = _quats(seg_rot)
         # sign continuity so the spline does not cross the quaternion double cover
         for f in range(1, F):
@@ -153,6 +180,61 @@ class MocapFigure(System, RigidParts):
         self._middle = np.array([pr.middle for pr in prims])  # m, segment frame
         self._view = BodiesView(self, SEGMENTS, self.segment_meshes(), prims,
                                 np.full(17, np.inf), movable=False)
+
+    def soles(self, seg_pos, seg_rot) -> np.ndarray:
+        """(F, 2) height (m) of the lowest point of the left and the right foot (foot and toes
+        segments) in each frame."""
+        out = np.empty((len(seg_pos), 2))
+        for side, pair in enumerate((("l_foot", "l_toes"), ("r_foot", "r_toes"))):
+            low = []
+            for name in pair:
+                k = SEGMENTS.index(name)
+                v = segment_mesh(self.plan[k].shape)[0]
+                low.append((seg_pos[:, k, 2, None]
+                            + np.einsum("fj,nj->fn", seg_rot[:, k, 2], v)).min(axis=1))
+            out[:, side] = np.minimum(*low)
+        return out
+
+    @staticmethod
+    def stances(seg_pos, sole, dt: float) -> np.ndarray:
+        """(F, 2) whether the left and the right foot stand in each frame: its ankle or its
+        toe joint (a foot rolls from the one to the other) slower than STANCE_SPEED, its sole
+        neither rising nor sinking faster than STANCE_SINK and within STANCE_RISE of its
+        lowest over the 0.3 s around."""
+        from scipy.ndimage import minimum_filter1d
+        out = np.zeros(sole.shape, dtype=bool)
+        for side, pair in enumerate((("l_foot", "l_toes"), ("r_foot", "r_toes"))):
+            speed = np.min([np.linalg.norm(np.gradient(seg_pos[:, SEGMENTS.index(n)], dt,
+                                                       axis=0), axis=1) for n in pair], axis=0)
+            near = minimum_filter1d(sole[:, side], size=max(3, int(0.3 / dt)), mode="nearest")
+            sink = np.abs(np.gradient(sole[:, side], dt))
+            out[:, side] = ((speed < STANCE_SPEED) & (sink < STANCE_SINK)
+                            & (sole[:, side] < near + STANCE_RISE))
+        return out
+
+    def plant(self, seg_pos, seg_rot, dt: float, ground) -> np.ndarray:
+        """(F,) vertical offset (m) per frame that puts the sole of the standing foot on the
+        ground in every stance frame (``stances``: a clip's sole drifts by centimetres within
+        a stance, from retargeting onto capsule feet and marker slip), the mean of the two
+        where both feet stand, and monotone cubic between stances."""
+        from scipy.interpolate import PchipInterpolator
+        height = ground if callable(ground) else (lambda x, y, g=float(ground): g)
+        sole = self.soles(seg_pos, seg_rot)
+        stand = self.stances(seg_pos, sole, dt)
+        F = len(sole)
+        total, count = np.zeros(F), np.zeros(F)
+        for side, name in enumerate(("l_foot", "r_foot")):
+            k = SEGMENTS.index(name)
+            for f in np.flatnonzero(stand[:, side]):
+                total[f] += float(height(*seg_pos[f, k, :2])) - float(sole[f, side])
+                count[f] += 1
+        on = count > 0
+        if not on.any():
+            return np.zeros(F)
+        t, v = np.flatnonzero(on).astype(float), total[on] / count[on]
+        if len(t) == 1:
+            return np.full(F, v[0])
+        return PchipInterpolator(t, v, extrapolate=False)(np.clip(np.arange(F), t[0], t[-1]))
 
     @staticmethod
     def _rest_positions(motion: Motion) -> np.ndarray:
@@ -267,11 +349,38 @@ class MocapFigure(System, RigidParts):
         return (m[:, None] * self.part_centres()).sum(axis=0) / m.sum()
 
     def shapes(self):
-        return [Shape(self.name, "parts", color=self.color,
-                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
-                             for v, t in self.segment_meshes()])]
+        return [figure_shape(self.name, self.plan, self.color)]
 
 
 def clip_path(name: str) -> Path:
-    """A clip in the shared mocap data folder (../shared/data/mocap next to the repository)."""
-    return Path(__file__).resolve().parents[3] / ".." / "shared" / "data" / "mocap" / name
+    """A clip in the mocap data folder: $INTERPLAY_MOCAP_DIR if set, else shared/data/mocap
+    beside the repository or beside any folder above it (a worktree's repository sits
+    deeper); or ``name`` itself when it is a path."""
+    import os
+    if os.environ.get("INTERPLAY_MOCAP_DIR"):
+        return Path(os.environ["INTERPLAY_MOCAP_DIR"]) / name
+    repo = Path(__file__).resolve().parents[3]
+    for base in (repo, *repo.parents):
+        folder = base / "shared" / "data" / "mocap"
+        if folder.is_dir():
+            return folder / name
+    return repo.parent / "shared" / "data" / "mocap" / name
+
+
+def check_clip(name: str) -> None:
+    """A parameter check: "" (no clip) or a readable BVH clip (a name in the mocap folder or a
+    path to a regular file, bounded in size: io.motion_file.check_file). ParameterError
+    naming the clips there otherwise, so a mistyped name is not a silent fallback."""
+    if not name:
+        return
+    path = clip_path(name)
+    if not path.exists():
+        folder = clip_path("")
+        have = sorted(p.name for p in folder.glob("*.bvh")) if folder.is_dir() else []
+        raise ParameterError(f"no clip {name!r}" + (
+            f"; clips in {folder.resolve()}: {', '.join(have)}" if have else
+            f" and no mocap folder at {folder.resolve()}") + "; or '' for the keyframed foot")
+    try:
+        check_file(path)
+    except BVHError as e:
+        raise ParameterError(str(e)) from None

@@ -49,35 +49,62 @@ class Path:
         return self.position(t), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-class PathFollower(System, RigidParts):
-    """A rigid mesh carried along a ``Path`` (x forward along the direction of travel).
+class Prop:
+    """A rig of one rigid part: vertices (n,3) m and triangles (m,3) in the frame of travel
+    (x forward, z up), that a PathFollower carries unchanged. color: linear RGB."""
 
-    vertices (n,3) m in the body frame and triangles (m,3); mass (kg) is what the analysis
-    divides forces by; dt (s) its output step (the motion is a function of time: any step is
-    exact). Forces are ignored. Generalized state: (x, y, z, yaw) and its rate. Its contact view:
-    one prescribed part, its mesh."""
+    PART_NAMES = ("body",)
+    PARENTS = (-1,)
+
+    def __init__(self, vertices, triangles, color=(0.55, 0.55, 0.57)):
+        self.parts = [(np.asarray(vertices, float), np.asarray(triangles, np.int64))]
+        self.COLORS = (tuple(color),)
+
+    def pose(self, s: float):
+        return np.zeros((1, 3)), np.eye(3)[None]
+
+    def mesh(self):
+        return self.parts[0]
+
+
+class PathFollower(System, RigidParts):
+    """A rig of rigid parts carried along a ``Path`` (x forward along the direction of travel).
+
+    rig: what it carries, with ``parts`` [(vertices (n,3) m, triangles)] in their own frames,
+    ``PART_NAMES``, ``PARENTS``, ``COLORS`` and ``pose(s) -> (origins (k,3) m, rotations
+    (k,3,3))`` in the rig's frame after s (m) travelled (geometry/bicycle.py: wheels turn,
+    legs pedal); ``mesh()`` the whole rig at rest. mass (kg) is what the analysis divides
+    forces by; dt (s) its output step (the motion is a function of time: any step is exact).
+    Forces are ignored. Generalized state: (x, y, z, yaw) and its rate. Its contact view: one
+    prescribed part, the whole rig at rest."""
 
     role = Role.PRESCRIBED
     integrator = "path (monotone cubic Hermite)"
 
-    def __init__(self, name, path: Path, vertices, triangles, mass=80.0, dt=1.0 / 60.0):
+    def __init__(self, name, path: Path, rig, mass=80.0, dt=1.0 / 60.0):
         super().__init__(name, dt)
-        self.path = path
-        self.body = np.asarray(vertices, dtype=float)
-        self.triangles = np.asarray(triangles, dtype=np.int64)
+        self.path, self.rig = path, rig
+        body, tris = rig.mesh()
         self._mass = require_positive(name, "mass", mass, "kg")
+        # distance travelled (m) against time: the path's speed integrated on a fine grid
+        ts = np.linspace(path.t0, path.t1, 2001)
+        speed = np.linalg.norm(np.array([path.velocity(t) for t in ts]), axis=1)
+        self._dist = (ts, np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1])
+                                                           * np.diff(ts))]))
         self.q = np.zeros(4)
         self.qd = np.zeros(4)
         self._place(0.0)
-        self.color = None
-        self._view = BodiesView(self, [name], [(self.body, self.triangles)], [None], [np.inf],
-                                movable=False)
+        self._view = BodiesView(self, [name], [(body, tris)], [None], [np.inf], movable=False)
 
     def _place(self, t):
         self.q[:3] = self.path.position(t)
         self.q[3] = self.path.yaw(t)
         self.qd[:3] = self.path.velocity(t)
         self.qd[3] = 0.0  # heading rate is not needed by anything downstream
+
+    def distance(self, t: float) -> float:
+        """Distance (m) travelled along the path by time t (s)."""
+        return float(np.interp(t, *self._dist))
 
     @property
     def mass(self):
@@ -93,10 +120,6 @@ class PathFollower(System, RigidParts):
     def _rotation(self):
         c, s = math.cos(self.q[3]), math.sin(self.q[3])
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-    def points(self) -> np.ndarray:
-        """The mesh's vertices in the world (m)."""
-        return self.body @ self._rotation().T + self.q[:3]
 
     def contact_view(self):
         return self._view
@@ -115,11 +138,24 @@ class PathFollower(System, RigidParts):
         return self.q[:3]
 
     def shapes(self):
-        return [Shape(self.name, "surface", color=self.color, triangles=self.triangles,
-                      palette="other")]
+        rig = self.rig
+        return [Shape(self.name, "parts", color=tuple(np.mean(rig.COLORS, axis=0)),
+                      parts=[(np.asarray(v, float), np.asarray(t, np.int64))
+                             for v, t in rig.parts],
+                      part_names=rig.PART_NAMES, part_parents=rig.PARENTS,
+                      part_colors=np.asarray(rig.COLORS, float), palette="rigid",
+                      material="paint")]
+
+    def world_parts(self):
+        """(origins (k,3) m, rotations (k,3,3)) of the rig's parts in the world now."""
+        pos, rot = self.rig.pose(self.distance(self.time))
+        R = self._rotation()
+        return pos @ R.T + self.q[:3], np.einsum("ij,kjl->kil", R, rot)
 
     def lowest_z(self):
-        return float(self.points()[:, 2].min())
+        pos, rot = self.world_parts()
+        return float(min((v @ r.T + p)[:, 2].min() for (v, _), p, r in
+                         zip(self.rig.parts, pos, rot)))
 
     def kinetic_energy(self):
         return 0.5 * self._mass * float(self.qd[:3] @ self.qd[:3])
@@ -135,4 +171,7 @@ class PathFollower(System, RigidParts):
         self.qd[:] = xdot
 
     def frame(self):
-        return {"points": self.points()}
+        from scipy.spatial.transform import Rotation
+        pos, rot = self.world_parts()
+        q = Rotation.from_matrix(rot).as_quat()  # x, y, z, w
+        return {"segment_positions": pos, "segment_orientations": np.roll(q, 1, axis=1)}

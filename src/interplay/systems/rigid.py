@@ -10,7 +10,8 @@ from ..errors import ParameterError, require_positive
 from ..kernels.rigid import (Body, Wrench, generalized, kinetic_energy, quat_mul,
                              quat_to_matrix, rigid_step)
 from .base import GRAVITY, System
-from .shape import Shape
+from ..params import param
+from .shape import Shape, split_color
 from ..geometry.primitive import Primitive
 from .views import BodiesView, RigidParts
 
@@ -18,10 +19,10 @@ from .views import BodiesView, RigidParts
 @dataclass(frozen=True)
 class SphereParams:
     """A sphere. radius in m, mass in kg; shell=True is a hollow shell (a basketball)."""
-    radius: float = 0.12  # m
-    mass: float = 0.68  # kg
-    shell: bool = True
-    dt: float = 1e-3  # s, largest integrator step
+    radius: float = param(0.12, "m", ge=1e-3, le=10.0, doc="radius")
+    mass: float = param(0.68, "kg", ge=1e-4, le=1e6, doc="mass")
+    shell: bool = param(True, doc="a hollow shell (I = 2/3 m r^2), else solid (2/5 m r^2)")
+    dt: float = param(1e-3, "s", ge=1e-9, le=0.1, doc="largest integrator step")
 
 
 class RigidBody(System, RigidParts):
@@ -57,6 +58,8 @@ class RigidBody(System, RigidParts):
         self._wrench = Wrench(self.force, self.torque, self.kext, self.dext)
         self._gx, self._gv = np.zeros(7), np.zeros(7)
         self.surface = surface
+        self.color = None  # linear RGB as drawn, or (n,3) one per surface vertex
+        self.material = "rubber"
         self._view = BodiesView(self, [name], [surface if surface is not None else
                                                (np.zeros((0, 3)), np.zeros((0, 3), np.int64))],
                                 [primitive], [self._mass], movable=True)
@@ -124,8 +127,10 @@ class RigidBody(System, RigidParts):
         if self.surface is None:
             return []
         v, t = self.surface
-        return [Shape(self.name, "body", verts=np.asarray(v, float), tris=np.asarray(t),
-                      palette="rigid")]
+        color, per_point = split_color(self.color)
+        return [Shape(self.name, "body", color=color, verts=np.asarray(v, float),
+                      tris=np.asarray(t), palette="rigid", point_colors=per_point,
+                      material=self.material)]
 
     # --- measures ------------------------------------------------------------------------------
     def kinetic_energy(self):

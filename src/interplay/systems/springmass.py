@@ -23,7 +23,7 @@ from ..kernels.contact import colliders as no_colliders
 from ..kernels.part_contact import Parts
 from ..kernels.subcycle import advance_with_colliders, advance_with_parts
 from .base import GRAVITY, System, substeps
-from .shape import Shape
+from .shape import Shape, split_color
 from .views import PointsView
 
 INTEGRATORS = ("explicit", "implicit", "localglobal")
@@ -354,18 +354,25 @@ class SpringNetwork(System):
         return self._view
 
     def shapes(self):
+        """A surface (cloth, flags, leaves: double-sided) or cords (a net, a bungee cord) at
+        their drawn width. ``color`` may be one colour or one per point ((n,3): autumn leaves
+        each their own)."""
         anchors = self.a_pos.copy() if len(self.a_pos) else None
+        color, per_point = split_color(self.color)
         if self.triangles is not None:
-            out = [Shape(self.name, "surface", color=self.color, triangles=self.triangles,
-                         anchors=anchors, palette="cloth")]
+            out = [Shape(self.name, "surface", color=color, triangles=self.triangles,
+                         anchors=anchors, palette="cloth", point_colors=per_point,
+                         material="cloth", double_sided=True)]
             if self.cords is not None:
+                # the springs a surface hangs from (a trampoline's frame springs): steel coils
                 out.append(Shape(f"{self.name}-cords", "cords", segments=self.cords,
                                  width=self._cord_width(self.cords), palette="static",
-                                 source=(self.name, "points")))
+                                 source=(self.name, "points"), material="metal"))
             return out
         seg = self.segments()
-        return [Shape(self.name, "cords", color=self.color, segments=seg,
-                      width=self._cord_width(seg), anchors=anchors, palette="cloth")]
+        return [Shape(self.name, "cords", color=color, segments=seg,
+                      width=self._cord_width(seg), anchors=anchors, palette="cloth",
+                      material="cloth")]
 
     def _cord_width(self, seg) -> float:
         """A drawn cord's diameter (m): twice cord_radius, else 8% of the median length."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from .base import Role, System
 from .shape import Shape
 from .views import ShapeView
@@ -37,13 +38,24 @@ class Stateless(System):
 
 
 class StaticPlane(Stateless):
-    """The plane z = height (m), infinitely massive; normal +z. size (m): its half-extent as
-    drawn."""
+    """The plane z = height (m), infinitely massive; normal +z. As drawn: the square of
+    half-extent size (m) about the origin, or the rectangle extent = (x0, x1, y0, y1) m (a
+    road along a path); drawn=False: a collider only (another shape draws that surface);
+    color (linear RGB 0..1) and material (systems/shape.py) as drawn."""
 
-    def __init__(self, name="ground", height=0.0, size=10.0):
+    def __init__(self, name="ground", height=0.0, size=10.0, extent=None, drawn=True,
+                 color=None, material="ground"):
         super().__init__(name)
         self.height = float(height)
         self.size = float(size)
+        if extent is None:
+            extent = (-self.size, self.size, -self.size, self.size)
+        x0, x1, y0, y1 = (float(e) for e in extent)
+        if not (x1 > x0 and y1 > y0):
+            raise ParameterError(f"{name}: extent (x0, x1, y0, y1) = {tuple(extent)} m must "
+                                 "have x1 > x0 and y1 > y0")
+        self.extent = (x0, x1, y0, y1)
+        self.drawn, self.color, self.material = bool(drawn), color, material
         self._view = ShapeView(self, self.distance, height=self.height)
 
     def distance(self, points):
@@ -57,10 +69,14 @@ class StaticPlane(Stateless):
         return self._view
 
     def surface(self):
-        s, z = self.size, self.height
-        v = np.array([[-s, -s, z], [s, -s, z], [s, s, z], [-s, s, z]])
+        x0, x1, y0, y1 = self.extent
+        z = self.height
+        v = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]])
         return v, np.array([[0, 1, 2], [0, 2, 3]])
 
     def shapes(self):
+        if not self.drawn:
+            return []
         v, t = self.surface()
-        return [Shape(self.name, "static", verts=v, tris=t, palette="static")]
+        return [Shape(self.name, "static", color=self.color, verts=v, tris=t, palette="static",
+                      material=self.material)]

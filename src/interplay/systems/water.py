@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, StabilityError, require_nonnegative, require_positive
+from ..kernels import lids as L
+from ..params import param, zero_or_at_least
 from ..kernels import water as K
 from .base import System
 from .shape import Shape
@@ -23,6 +25,13 @@ from .shape import Shape
 #: the wave-speed stability limit: dt < STABLE_CFL * l / sqrt(g d) (the pipe update is stable
 #: up to 1.0 for the fastest 8-pipe mode; 0.7 leaves room for depth growing within a step)
 STABLE_CFL = 0.7
+
+# linear RGB as drawn: clear water over a muddy sand bed; spray as white foam droplets
+WATER_COLOR = (0.06, 0.25, 0.30)
+SPRAY_COLOR = (0.92, 0.96, 1.0)
+BED_COLOR = (0.45, 0.37, 0.25)
+BANK_COLOR = (0.30, 0.42, 0.20)  # the grass the bed rises into above the water
+BED_STRIDE = 2  # columns per drawn bed cell
 
 
 @dataclass(frozen=True)
@@ -32,12 +41,12 @@ class SprayParams:
     capacity: most particles airborne at once (output frames are padded to it); drag: drag
     coefficient (-) of a droplet in air of density air_density (kg/m^3)."""
     enabled: bool = True
-    threshold: float = 0.6  # m/s
-    fraction: float = 0.3
-    radius: float = 0.004  # m
-    capacity: int = 4096
-    drag: float = 0.47
-    air_density: float = 1.2  # kg/m^3
+    threshold: float = param(0.6, "m/s", ge=1e-6, le=100.0)
+    fraction: float = param(0.3, "-", ge=0.0, le=1.0)
+    radius: float = param(0.004, "m", ge=1e-5, le=0.1)
+    capacity: int = param(4096, "particles", ge=1, le=10_000_000, cost="particles")
+    drag: float = param(0.47, "-", ge=0.0, le=10.0)
+    air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
 
 
 @dataclass(frozen=True)
@@ -50,14 +59,16 @@ class WaterParams:
     body touches the water the substeps shrink by sqrt(1 + kappa). body_samples: sample points
     per column side where a body cuts the columns. body_damping (1/s): extra pipe friction
     under a body (its wetted surface), which damps waves trapped under it."""
-    density: float = 1000.0  # kg/m^3
-    gravity: float = 9.81  # m/s^2
-    damping: float = 0.5  # 1/s
-    cfl: float = 0.5
-    dt: float = 0.0  # s, 0 = automatic
-    body_stiffness: float = 30.0
-    body_samples: int = 4
-    body_damping: float = 200.0  # 1/s
+    density: float = param(1000.0, "kg/m^3", ge=1.0, le=1e5)
+    gravity: float = param(9.81, "m/s^2", ge=0.01, le=100.0)
+    damping: float = param(0.5, "1/s", ge=0.0, le=1e4)
+    cfl: float = param(0.5, "-", ge=0.01, le=0.7)
+    dt: float = param(0.0, "s", ge=0.0, le=0.1, check=zero_or_at_least(1e-9),
+                      doc="0: automatic")
+    # the substeps shrink by sqrt(1 + kappa) under a body: 1e4 is 100x the steps
+    body_stiffness: float = param(30.0, "-", ge=1e-6, le=1e4)
+    body_samples: int = param(4, "-", ge=1, le=16)
+    body_damping: float = param(200.0, "1/s", ge=0.0, le=1e5)
     spray: SprayParams = SprayParams()
 
 
@@ -66,7 +77,7 @@ class Water(System):
 
     bed: (nx, ny) bed heights (m); fluid: (nx, ny) mask, False is wall; depth: (nx, ny) initial
     water depth (m, >= 0); spacing: column width l (m); origin: centre (m) of column (0, 0).
-    Bodies register where they cut the columns (``add_ellipsoid``) at every coupling step;
+    Bodies register where they cut the columns (``add_solids``) at every coupling step;
     the water's external pressure follows from that and from its own state in every substep
     (kernels/water.py ``heads``); ``clear_forces`` forgets them.
     """
@@ -151,7 +162,9 @@ class Water(System):
         self.pv = np.zeros((cap, 3))
         self.count = 0
         self._steps = 0
-        self._track = np.array([0.0, float(d[fluid].min())])  # peak particles, min depth
+        self._track = np.zeros(K.TRACKED)  # what the run has seen: kernels/water.py
+        self._track[K.MIN_DEPTH] = float(d[fluid].min())
+        self._track[K.HIGHEST] = -np.inf
         self.volume0 = self.total_volume()
         self._drift = 0.0
         self._em = np.zeros(4)
@@ -163,7 +176,9 @@ class Water(System):
                                     float(s.fraction), self.particle_volume, float(s.radius),
                                     self.air_drag)
         self._scratch = K.Scratch(np.zeros(bed.shape), np.zeros(bed.shape), np.zeros(bed.shape))
-        self.color = None
+        # linear RGB as drawn: the water (None: WATER_COLOR), its bed below the still water and
+        # the bed where it rises above it (the banks)
+        self.color, self.bed_color, self.bank_color = None, BED_COLOR, BANK_COLOR
 
     # --- the System protocol -----------------------------------------------------------------
     @property
@@ -172,18 +187,20 @@ class Water(System):
 
     def clear_forces(self):
         self.n_lid = 0
+        self.n_solid = 0
         self.ext[:] = 0.0
 
     def _grow_lids(self, cap):
         s2 = self.samples * self.samples
         old = getattr(self, "n_lid", 0)
-        arrays = (np.zeros(cap, np.int64), np.zeros((cap, s2)), np.zeros((cap, s2)),
-                  np.zeros(cap), np.zeros(cap))
+        arrays = (np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.zeros((cap, s2)),
+                  np.zeros((cap, s2)), np.zeros(cap), np.zeros(cap))
         if old:
             for new, cur in zip(arrays, self._lids):
                 new[:old] = cur[:old]
-        self._lids = K.Lids(*arrays)
+        self._lids = L.Lids(*arrays)
         self.n_lid = old
+        self.n_solid = getattr(self, "n_solid", 0)
 
     def _run(self, h, dt_max):
         self.count, _ = K.advance(self._grid, self._state, self._lids, self.n_lid,
@@ -234,14 +251,39 @@ class Water(System):
         return verts, tris
 
     def shapes(self):
-        """The surface (a height field over the columns) and its spray."""
+        """The surface (a height field over the columns: translucent water, its bed heights
+        tell wet columns from dry), its spray (bright droplets) and the bed under it (the
+        basin's floor and walls, a static mesh over every column)."""
         _, tris = self.surface()
         X, Y = self.column_centres()
-        out = [Shape(self.name, "surface", color=self.color, triangles=np.asarray(tris, np.int64),
-                     grid_xy=np.stack([X.ravel(), Y.ravel()], axis=1))]
+        xy = np.stack([X.ravel(), Y.ravel()], axis=1)
+        out = [Shape(self.name, "surface", color=self.color or WATER_COLOR,
+                     triangles=np.asarray(tris, np.int64), grid_xy=xy,
+                     base=self.bed.ravel().copy(), material="water")]
         if self.spray_on:
-            out.append(Shape(f"{self.name}-spray", "particles", color=self.color,
-                             width=2.0 * self.params.spray.radius, source=(self.name, "particles")))
+            out.append(Shape(f"{self.name}-spray", "particles", color=SPRAY_COLOR,
+                             width=2.0 * self.params.spray.radius, source=(self.name, "particles"),
+                             material="spray"))
+        # the bed at every BED_STRIDE-th column (the outer ones kept): a static mesh 4x
+        # lighter to draw, within millimetres of the bed on the shore's linear slope
+        X, Y = self.column_centres()
+        ix = np.unique(np.r_[np.arange(0, self.shape[0], BED_STRIDE), self.shape[0] - 1])
+        iy = np.unique(np.r_[np.arange(0, self.shape[1], BED_STRIDE), self.shape[1] - 1])
+        bed = self.bed[np.ix_(ix, iy)]
+        nx, ny = bed.shape
+        idx = np.arange(nx * ny).reshape(nx, ny)
+        a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+        c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+        # sand below the highest still water, turning to the banks' colour up to the rim
+        wet = self.fluid & (self.V > 0.0)
+        level = float(np.max(np.where(wet, self.bed + self.V / self.area, -np.inf)))
+        up = np.clip((bed.ravel() - level) / max(float(self.bed.max()) - level, 1e-3), 0.0,
+                     1.0)[:, None]
+        colors = (1 - up) * np.asarray(self.bed_color) + up * np.asarray(self.bank_color)
+        verts = np.stack([X[np.ix_(ix, iy)].ravel(), Y[np.ix_(ix, iy)].ravel(), bed.ravel()], 1)
+        out.append(Shape(f"{self.name}-bed", "static", color=self.bed_color, verts=verts,
+                         tris=np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]),
+                         palette="static", material="ground", point_colors=colors))
         return out
 
     def frame(self):
@@ -282,10 +324,14 @@ class Water(System):
     def extra_diagnostics(self) -> dict:
         """volume_drift_rel: largest relative change of the total volume (columns plus
         airborne spray) seen in the run; peak_particles; min_depth_m: shallowest fluid column
-        seen (0 where the water left a column dry)."""
+        seen (0 where the water left a column dry); spray_emitted_m3: the volume that left
+        the surface as spray in all; spray_top_m: the highest a drop flew (m, None if none)."""
         drift = max(self._drift, abs(self.total_volume() / self.volume0 - 1.0))
-        return {"volume_drift_rel": drift, "peak_particles": int(self._track[0]),
-                "min_depth_m": float(self._track[1])}
+        t = self._track
+        return {"volume_drift_rel": drift, "peak_particles": int(t[K.PEAK]),
+                "min_depth_m": float(t[K.MIN_DEPTH]),
+                "spray_emitted_m3": float(t[K.EMITTED]) * self.particle_volume,
+                "spray_top_m": float(t[K.HIGHEST]) if t[K.EMITTED] else None}
 
     # --- state ---------------------------------------------------------------------------------
     def generalized_state(self):
@@ -308,7 +354,7 @@ class Water(System):
     def restore(self, snap):
         for key in ("V", "Q", "ext", "rate"):
             getattr(self, key)[:] = snap[key]
-        self.n_lid = 0  # bodies register again at the next coupling step
+        self.n_lid = self.n_solid = 0  # bodies register again at the next coupling step
         n = int(snap["count"])
         self.px[:n] = snap["px"]
         self.pv[:n] = snap["pv"]
@@ -319,28 +365,30 @@ class Water(System):
         self.time = float(snap["time"])
 
     # --- bodies --------------------------------------------------------------------------------
-    def add_ellipsoid(self, centre, vz, A, M, volume, keep=True):
-        """Register the body {p: (p-c)^T A (p-c) <= 1} (M = A^-1, volume in m^3), moving up
-        at vz (m/s), for this coupling step: where it cuts the columns, water rising into it
-        meets external pressure. Returns the (start, stop) range of its lids for
-        ``body_load``; keep=False measures without pressing on the water (the range is then
-        valid until the next call)."""
-        start = self.n_lid
+    def add_solids(self, solids: L.Solids):
+        """Register solids (kernels/lids.py ``Solids``: world ellipsoids, capsules, boxes with
+        their volumes and vertical speeds) for this coupling step: where they cut the
+        columns, water rising into them meets external pressure. Returns the (first, stop)
+        range of the numbers they are known by in ``solid_loads``."""
+        first = self.n_solid
         while True:
-            n = K.add_ellipsoid(centre, vz, A, M, volume, self._grid, self.samples, self._lids,
-                                start)
+            n = L.add_solids(solids, self._grid, self.samples, self._lids, self.n_lid, first)
             if n >= 0:
                 break
             self._grow_lids(2 * self._lids.cell.shape[0])
-        if keep:
-            self.n_lid = n
-        return start, n
+        L.group_lids(self._lids, n)
+        self.n_lid = n
+        self.n_solid = first + len(solids.kind)
+        return first, self.n_solid
 
-    def body_load(self, lids, out):
-        """The water's push on a body from its lids (``add_ellipsoid``): out (7,) receives
-        the displaced volume (m^3; rho g times it is the buoyancy), the centre of buoyancy (m)
-        and the water's velocity there (m/s)."""
-        K.lid_load(self._grid, self._state, self._lids, lids[0], lids[1], self.kappa, out)
+    def solid_loads(self, solids, out):
+        """The water's push on registered solids (the range ``add_solids`` returned): out
+        (k, 7) receives per solid the displaced volume (m^3; rho g times it is the buoyancy),
+        the centre of buoyancy (m) and the water's velocity there (m/s). Solids registered
+        together share the columns they cut exactly; one registered later is seen by them
+        from the next coupling step."""
+        K.solid_loads(self._grid, self._state, self._lids, self.n_lid, solids[0], solids[1],
+                      self.kappa, out)
         return out
 
 

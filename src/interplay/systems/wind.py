@@ -12,16 +12,22 @@ from ..errors import ParameterError, require_nonnegative
 from ..kernels import wind as K
 from .static import Stateless
 
-KINDS = {"uniform": K.UNIFORM, "source": K.SOURCE, "sink": K.SOURCE, "vortex": K.VORTEX}
+KINDS = {"uniform": K.UNIFORM, "source": K.SOURCE, "sink": K.SOURCE, "vortex": K.VORTEX,
+         "turbulence": K.TURBULENCE}
+TURBULENCE_MODES = 12  # Fourier modes of a turbulence primitive
 
 
 @dataclass(frozen=True)
 class FlowPrimitive:
-    """One primitive. kind: uniform | source | sink | vortex (formulas in ``kernels.wind``).
+    """One primitive. kind: uniform | source | sink | vortex | turbulence (formulas in
+    ``kernels.wind``).
 
     position (m) of the centre at t = 0; axis: the flow direction (uniform) or the vortex
-    axis (normalized here); strength: U m/s, q m^3/s (a sink draws in q) or Gamma m^2/s;
-    core (m): the regularizing core radius r_c; velocity (m/s): a constant drift; gust: the
+    axis (normalized here); strength: U m/s, q m^3/s (a sink draws in q), Gamma m^2/s, or the
+    turbulence's rms speed per component (m/s); core (m): the regularizing core radius r_c,
+    or the turbulence's length scale (its modes' wavelengths run from core/4 to 2 core, their
+    amplitudes following Kolmogorov's k^-5/3 spectrum); velocity (m/s): a constant drift (the
+    mean wind a turbulence is carried by); gust: the
     relative amplitude of the strength's fluctuation, gust_period (s) its main period and
     phase (rad) its offset, so several primitives need not gust in step. With a ``path``,
     position and axis are in the path's moving frame (x forward, z up) and ride along it.
@@ -64,6 +70,25 @@ class FlowPrimitive:
              + 0.35 * math.sin(3.31 * w + 4.2 + self.phase)) / 1.95
         return 1.0 + self.gust * g
 
+    def modes(self) -> np.ndarray:
+        """(TURBULENCE_MODES, 7) rows [k (1/m), A (unit rms per component), phi (rad)] of a
+        turbulence primitive: wavenumbers log-spaced over 2 pi / (2 core) .. 2 pi / (core / 4)
+        in random directions, each amplitude perpendicular to its wavevector (divergence-free)
+        and weighted k^-1/3 (a k^-5/3 energy spectrum over log-spaced bands), seeded by phase
+        so a scene repeats."""
+        rng = np.random.default_rng(int(round(1e6 * self.phase)) % (2 ** 32))
+        n = TURBULENCE_MODES
+        k = 2.0 * math.pi / max(self.core, 1e-9) * np.geomspace(0.5, 4.0, n)
+        d = rng.normal(size=(n, 3))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        a = rng.normal(size=(n, 3))
+        a -= np.sum(a * d, axis=1, keepdims=True) * d
+        a /= np.linalg.norm(a, axis=1, keepdims=True)
+        w = k ** (-1.0 / 3.0)
+        w *= math.sqrt(6.0 / np.sum(w * w))  # each component's rms: sqrt(sum w^2 / 6) = 1
+        return np.concatenate([k[:, None] * d, a * w[:, None],
+                               rng.uniform(0.0, 2.0 * math.pi, (n, 1))], axis=1)
+
 
 class WindField(Stateless):
     """The air: a stateless system (never stepped by the scheduler, infinitely massive) whose
@@ -72,6 +97,9 @@ class WindField(Stateless):
     def __init__(self, name="wind", primitives=()):
         super().__init__(name)
         self.primitives = [p.checked(name) for p in primitives]
+        rows = [np.c_[np.full(TURBULENCE_MODES, q), p.modes()]
+                for q, p in enumerate(self.primitives) if p.kind == "turbulence"]
+        self._modes = np.concatenate(rows) if rows else np.zeros((0, 8))
 
     def arrays(self, t: float):
         """(kind, centre, axis, strength, core) arrays of the primitives at time t."""
@@ -96,5 +124,5 @@ class WindField(Stateless):
         """Wind velocity (m/s) at points (n,3) m at time t (s)."""
         pts = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
         out = np.empty_like(pts)
-        K.sample(pts, *self.arrays(t), out)
+        K.sample(pts, *self.arrays(t), self._modes, out)
         return out

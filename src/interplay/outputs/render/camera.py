@@ -104,3 +104,66 @@ def default_camera(lo, hi, aspect: float, fov_deg: float = 35.0, azimuth_deg: fl
     need = np.maximum(np.abs(corners @ right) / tan_h, np.abs(corners @ up) / tan_v) - depth
     dist = max(float(need.max()), 0.5)
     return Camera(tuple(centre + back * dist), tuple(centre), fov_deg)
+
+
+@dataclass(frozen=True)
+class TrackingCamera:
+    """A camera that travels with a system (the jumper, the rider, the runner): it looks at
+    the system's position plus ``target_offset`` from there plus ``offset`` (m, world axes),
+    with vertical field of view fov_deg. ``axes`` (1 or 0 per world axis) says which
+    coordinates it follows; on the others it holds ``hold`` (m). The followed path is low-pass
+    filtered forward and backward in time with time constant smooth_s (s), so the camera
+    eases along without lag or jitter. A system's position: a body's, a figure's root segment
+    (its first part), or the mean of its points."""
+    follow: str
+    offset: tuple
+    target_offset: tuple = (0.0, 0.0, 0.0)
+    fov_deg: float = 35.0
+    axes: tuple = (1, 1, 1)
+    hold: tuple = (0.0, 0.0, 0.0)
+    smooth_s: float = 0.4
+
+    def spec(self) -> str:
+        return f"tracking {self.follow}, offset {tuple(round(v, 3) for v in self.offset)} m"
+
+    def path(self, run, times) -> list:
+        """The Camera at each of ``times`` (s)."""
+        times = np.asarray(times, dtype=float)
+        p = np.array([_position(run, self.follow, t) for t in times])
+        if len(times) > 1 and self.smooth_s > 0:
+            p = _smooth(p, float(np.median(np.diff(times))) / self.smooth_s)
+        axes, hold = np.asarray(self.axes, float), np.asarray(self.hold, float)
+        target = axes * p + (1 - axes) * hold + np.asarray(self.target_offset, float)
+        eye = target + np.asarray(self.offset, float)
+        return [Camera(tuple(e), tuple(c), self.fov_deg) for e, c in zip(eye, target)]
+
+
+def _position(run, name: str, t: float) -> np.ndarray:
+    st = run.sample(name, t)
+    if "position" in st:
+        return np.asarray(st["position"], float)
+    if "segment_positions" in st:
+        return np.asarray(st["segment_positions"][0], float)
+    return np.nanmean(np.asarray(st["points"], float), axis=0)
+
+
+def _smooth(p: np.ndarray, a: float) -> np.ndarray:
+    """Forward then backward first-order low-pass (zero phase); a = step / time constant."""
+    k = 1.0 - math.exp(-a)
+    out = p.copy()
+    for direction in (range(1, len(p)), range(len(p) - 2, -1, -1)):
+        for i in direction:
+            j = i - 1 if direction.step == 1 else i + 1
+            out[i] = out[j] + k * (out[i] - out[j])
+    return out
+
+
+def cameras(camera, run, times, aspect: float) -> list:
+    """One Camera per time (s): a fixed Camera, a TrackingCamera's path, or (None) the
+    default framing of every animated system over the whole run."""
+    if camera is None:
+        lo, hi = run.bounds()
+        camera = default_camera(lo, hi, aspect)
+    if isinstance(camera, TrackingCamera):
+        return camera.path(run, times)
+    return [camera] * len(times)

@@ -1,6 +1,6 @@
 """Preview videos: H.264 MP4 through imageio-ffmpeg's bundled ffmpeg.
 
-Video frames are sampled by time (default 30 frames/s, whatever the run's output rate):
+Video frames are sampled by time (default 24 frames/s, whatever the run's output rate):
 between the run's frames, states are interpolated (``RunData.sample``).
 """
 from __future__ import annotations
@@ -81,7 +81,7 @@ def _label(run, t, title=None):
     return [title or f"{run.scene} - {run.coupling}", f"t = {t:.3f} s"]
 
 
-def render_video(run, path, size=(1280, 720), fps: float = 30.0, camera=None,
+def render_video(run, path, size=(960, 540), fps: float = 24.0, camera=None,
                  progress=None) -> dict:
     """Render the run to an MP4 at ``path``. Returns {"path", "frames", "size", "fps",
     "camera", "render_s", "encode_s"} (wall times in s). progress: callable(done, total)."""
@@ -101,7 +101,7 @@ def render_video(run, path, size=(1280, 720), fps: float = 30.0, camera=None,
             "camera": cam.spec(), **timer}
 
 
-def render_side_by_side(runs: dict, path, size=(1280, 720), fps: float = 30.0, camera=None,
+def render_side_by_side(runs: dict, path, size=(960, 540), fps: float = 24.0, camera=None,
                         progress=None) -> dict:
     """One MP4 with a panel per run, left to right (the paper's Figure 2 as a movie).
 
