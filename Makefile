@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_THREADING_LAYER ?= workqueue
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: clean-numba demo test test-all bench bench-cloth clean sysdeps browser fuzz
+.PHONY: clean-numba demo test test-all bench bench-sweep bench-cloth clean sysdeps browser fuzz
 
 # The preview renderer needs Mesa's EGL driver (headless OpenGL on the CPU); the slow browser
 # tests need Chromium. apt runs only when something is missing, and only as root.
@@ -38,11 +38,18 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/pytest -q
 
+# the slow tests include the Ray executor's: Ray (~240 MB, ~11 s to install here) only for them
 test-all: $(STAMP) browser
+	$(BIN)/pip install -q -e '.[cluster]'
 	$(BIN)/pytest -q -m ""
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_basketball.py --out out/bench
+
+# a wedge of 8 runs on 1 and 2 local workers and on a local Ray cluster; ~5 min
+bench-sweep: $(STAMP)
+	$(BIN)/pip install -q -e '.[cluster]'
+	$(BIN)/python benchmarks/bench_sweep.py --out out/bench
 
 # the cloth drape against MuJoCo and NVIDIA Newton (installed here: ~480 MB); ~30-60 min
 bench-cloth: $(STAMP)

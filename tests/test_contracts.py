@@ -189,6 +189,13 @@ def test_every_cli_verb_on_every_scene_exits_0_or_prints_one_line(name, tmp_path
     assert (code == 0) == (spec(name).fit_time is not None)
     code, err = one_line_or_success(capsys, ["view", str(tmp_path / "nowhere")])
     assert code == 2 and "no scene.json" in err
+    code, err = one_line_or_success(capsys, ["sweep", name, "--out", out + "-sweep", *QUICK,
+                                             "--vary", f"coupling={spec(name).couplings[0]}",
+                                             "--workers", "1", "--no-stills"])
+    assert code == 0
+    code, err = one_line_or_success(capsys, ["tune", name, "--out", out + "-tune", "--quiet",
+                                             "--budget", "2", "--chains", "1"])
+    assert (code == 0) == bool(spec(name).searches), err
 
 
 def test_refusals_come_before_any_simulation(capsys, monkeypatch):
@@ -205,6 +212,8 @@ def test_refusals_come_before_any_simulation(capsys, monkeypatch):
                        (["run", "flags", "--coupling", "hybrid"],
                         "flags supports one-way coupling, not hybrid"),
                        (["run", "pond", "--integrator", "implicit"],
-                        "--integrator implicit does not apply")):
+                        "--integrator implicit does not apply"),
+                       (["sweep", "basketball", "--vary", "ball.mass=0.6,-1"],
+                        "variant ball.mass=-1: ")):
         code, err = one_line_or_success(capsys, argv)
         assert code == 2 and says in err, (argv, err)

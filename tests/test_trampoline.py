@@ -324,26 +324,45 @@ def test_bed_too_soft_is_a_named_warning():
 
 # --- the command line ---------------------------------------------------------------------
 def test_controller_file_with_unknown_or_missing_parameters_is_one_line(tmp_path, capsys):
-    good = {f: getattr(BounceParams(), f) for f in BounceParams.__dataclass_fields__}
-    cases = {"unknown": {**good, "k_wobble": 1.0},
-             "missing": {k: v for k, v in good.items() if k != "lean"}}
-    for what, params in cases.items():
+    """--controller reads a tune.json: a file of unknown or missing search parameters, of
+    another scene, not JSON or absent is one line, exit 2, before anything runs."""
+    good = {k: 0.1 for k in T.SPEC.search().bounds}
+    cases = {"unknown": {**good, "bounce.k_wobble": 1.0},
+             "missing": {k: v for k, v in good.items() if k != "bounce.lean"},
+             "not bungee": None, "not JSON": None}
+    for what, best in cases.items():
         path = tmp_path / f"{what}.json"
-        path.write_text(json.dumps({"scene": "trampoline", "params": params}))
+        if what == "not JSON":
+            path.write_text("{best: ")
+        else:
+            path.write_text(json.dumps({"scene": "bungee" if what == "not bungee" else
+                                        "trampoline", "search": "bounce", "best": best or good}))
         assert main(["run", "trampoline", "--controller", str(path), "--out",
                      str(tmp_path / "o"), "--quiet"]) == 2
         err = capsys.readouterr().err.strip().splitlines()
-        assert len(err) == 1 and what in err[0]
+        assert len(err) == 1 and what.split()[-1] in err[0], err
     assert main(["run", "trampoline", "--controller", str(tmp_path / "none.json")]) == 2
     assert "cannot read" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
 
 
-def test_tune_refuses_bad_requests_before_any_trial(capsys):
-    assert main(["tune", "basketball"]) == 2
-    assert "no controller search" in capsys.readouterr().err
-    assert main(["tune", "trampoline", "--budget", "0"]) == 2
-    assert main(["tune", "trampoline", "--coupling", "one-way"]) == 2
+def test_controller_file_sets_the_searched_parameters(tmp_path):
+    """A tune.json's best values become the run's parameters (and --set still wins)."""
+    from interplay.cli.controller import controller_sets
+    best = {k: 0.5 * (lo + hi) for k, (lo, hi) in T.SPEC.search().bounds.items()}
+    path = tmp_path / "tune.json"
+    path.write_text(json.dumps({"scene": "trampoline", "search": "bounce", "best": best}))
+    sets = controller_sets(T.SPEC, path)
+    assert {k: float(v) for k, v in sets.items()} == best
+
+
+def test_tune_refuses_bad_requests_before_any_trial(tmp_path, capsys):
+    assert main(["tune", "basketball", "--out", str(tmp_path / "b")]) == 2
+    assert "no search" in capsys.readouterr().err
+    assert main(["tune", "trampoline", "--budget", "0", "--out", str(tmp_path / "t")]) == 2
+    assert "budget" in capsys.readouterr().err
     assert main(["run", "trampoline", "--integrator", "implicit"]) == 2
+    assert not (tmp_path / "t" / "evaluations.jsonl").exists()
 
 
 # --- the default run ----------------------------------------------------------------------

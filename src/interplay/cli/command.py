@@ -1,4 +1,4 @@
-"""The ``interplay`` command: list, run, compare, fit-standin, tune (cli/tune.py) and view.
+"""The ``interplay`` command: list, run, compare, fit-standin, view; sweep and tune (sweep.py).
 
 Errors a user can cause print one line (no traceback) and exit with status 2.
 """
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from .. import params as P
 from ..errors import CostError, InterplayError, ParameterError, StabilityError
 from ..params import param
+from .sweep import add_parsers, cmd_sweep, cmd_tune
 
 
 #: the smallest preview the captions fit in (the overlay's text is ~130 px wide, 34 px high)
@@ -133,7 +134,7 @@ def _parser():
     run.add_argument("--coupling", default=None,
                      help="two-way | one-way | hybrid (default: the scene's own)")
     run.add_argument("--controller", default=None, metavar="FILE",
-                     help="controller parameters from `interplay tune` (controller.json)")
+                     help="a controller from `interplay tune` (its tune.json)")
     _resume_options(run)
     _output_options(run)
     cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
@@ -141,12 +142,11 @@ def _parser():
     _output_options(cmp_)
     fit = sub.add_parser("fit-standin", help="fit the hybrid stand-in to a two-way run")
     _scene_options(fit)
-    from .tune import add_parser as add_tune
-    add_tune(sub)
     view = sub.add_parser("view", help="serve a saved run in a web viewer on localhost")
     view.add_argument("dir", help="a run directory, e.g. out/basketball/two-way")
     view.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
     view.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    add_parsers(sub, _scene_options, _output_options)
     return ap
 
 
@@ -163,7 +163,7 @@ def _build_kwargs(args):
             raise ParameterError(f"--set {item[:80]}: expected KEY=VALUE")
         assignments[key.strip()] = value.strip()
     if getattr(args, "controller", None):  # a tuned controller; --set still overrides it
-        from .tune import controller_sets
+        from .controller import controller_sets
         assignments = {**controller_sets(spec, args.controller), **assignments}
     try:
         params = P.apply(spec.params(), assignments)
@@ -338,18 +338,13 @@ def _vec(v):
     return "(" + ", ".join(f"{x:.3f}" for x in v) + ")"
 
 
-def cmd_tune(args, console):
-    from .tune import cmd_tune as tune
-    tune(args, console)
-
-
 def cmd_view(args, console):
     from .viewer import serve
     serve(args.dir, host=args.host, port=args.port, log=lambda m: print(m, flush=True))
 
 
 COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit,
-            "tune": cmd_tune, "view": cmd_view}
+            "view": cmd_view, "sweep": cmd_sweep, "tune": cmd_tune}
 
 
 def _argv(argv):
@@ -406,7 +401,7 @@ def main(argv=None) -> int:
         previous = None
     quiet_mujoco()
     try:
-        COMMANDS[args.command](args, console)
+        code = COMMANDS[args.command](args, console)
     except InterplayError as e:
         print(f"interplay: error: {e}", file=sys.stderr)
         return 2
@@ -415,6 +410,9 @@ def main(argv=None) -> int:
         print(f"interplay: {how}; `interplay run ... --resume` continues from the last "
               "checkpoint", file=sys.stderr)
         return 143 if isinstance(e, Terminated) else 130
+    except BrokenPipeError:  # the reader (head, less) stopped reading: not a failure
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except Exception as e:  # noqa: BLE001 - a bug, not the user's input: one line, exit 3
         if os.environ.get("INTERPLAY_DEBUG"):
             raise
@@ -425,7 +423,7 @@ def main(argv=None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
-    return 0
+    return code or 0
 
 
 if __name__ == "__main__":

@@ -101,7 +101,7 @@ class BounceParams:
 
 #: the search's box: name -> (low, high), in the units above
 BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4), "leg_omega": (6.0, 20.0),
-          "thrust_delay": (0.0, 0.3), "power": (0.3, 2.0), "ankle_push": (-0.6, 0.1),
+          "thrust_delay": (0.0, 0.3), "power": (0.3, 2.0), "ankle_push": (-0.6, 0.4),
           "arm_swing": (1.5, 3.1), "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6),
           "k_place": (0.0, 1.0), "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5),
           "k_spin": (0.0, 0.05), "k_attitude": (0.0, 1.2),

@@ -12,12 +12,12 @@ upright body.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .bounce import BOUNDS
-from .search import TuneProblem
+from .search import Search
 
 TILT_GOOD = 0.35  # rad: the pelvis's largest tilt from vertical at a good landing
 TILT_FALLEN = 1.0  # rad: past this she has fallen (the trial stops)
@@ -152,28 +152,32 @@ def score(record: BounceRecord, centre=(1.0, 0.5)) -> tuple[float, dict]:
     return loss, metrics
 
 
-def evaluate(task) -> tuple[float, dict]:
-    """A process pool's work item: task = (scene params, controller values {name: value},
-    coupling, duration); returns (loss, metrics)."""
-    params, values, coupling, duration = task
-    params = replace(params, bounce=replace(params.bounce, **values))
-    return score(trial(params, coupling, duration))
+def bounce_loss(coupling: str, kw: dict) -> float:
+    """The search's loss (``control.search.Search``; module-level, so a worker can import it):
+    a trial of the scene's parameters ``kw["params"]`` for ``kw["duration"]`` s in
+    ``coupling`` (two-way, or hybrid: her pass on the stand-in), scored by ``score``."""
+    return score(trial(kw["params"], coupling, kw["duration"]))[0]
 
 
-#: where the stand-in search begins: set by hand (docs/trampoline.md tells how)
+#: where the stand-in search starts, set by hand (docs/trampoline.md tells how); the search
+#: starts from the scene's parameters, so the command that made the shipped controller sets
+#: these (``start_sets``)
 HAND_START = {"knee_land": 0.2, "lean": 0.0, "trunk": 0.0, "leg_omega": 12.0,
               "thrust_delay": 0.12, "power": 1.0, "ankle_push": 0.2, "arm_swing": 2.8,
-              "arm_land": 0.6, "k_speed": 0.15, "k_place": 0.05, "k_lead": 5.0,
-              "k_drift": 0.3, "k_spin": 0.02, "k_attitude": 0.3, "k_turn": 0.0,
+              "arm_land": 0.6, "k_speed": 0.3, "k_place": 0.3, "k_lead": 5.0,
+              "k_drift": 0.3, "k_spin": 0.02, "k_attitude": 0.0, "k_turn": 0.0,
               "k_hip_spin": 0.0, "k_arms": 0.0}
-#: where the two-way search begins: the stand-in search's result (``interplay tune
-#: trampoline --coupling hybrid --budget 400 --seed 0``; tune on the stand-in, finish
-#: two-way)
-STANDIN_RESULT = {"knee_land": 0.5161, "lean": 0.1446, "trunk": 0.0593, "leg_omega": 8.2683, "thrust_delay": 0.3, "power": 0.3, "ankle_push": -0.4271, "arm_swing": 2.485, "arm_land": 0.0916, "k_speed": 0.3803, "k_place": 0.1034, "k_lead": 2.3935, "k_drift": 1.5, "k_spin": 0.011, "k_attitude": 1.2, "k_turn": 0.0, "k_hip_spin": 0.0, "k_arms": 0.0}
 
-TUNE = TuneProblem(field="bounce", bounds=BOUNDS, evaluate=evaluate,
-                   starts={"two-way": STANDIN_RESULT, "hybrid": HAND_START},
-                   duration=DURATION, budget=100, coordinates=3)
+
+def start_sets(values: dict = HAND_START) -> list[str]:
+    """``--set`` items that put the search's start at ``values`` ({controller field: value})."""
+    return [f"bounce.{k}={v!r}" for k, v in values.items()]
+
+
+BOUNCE = Search(
+    "bounce", "the bounce controller: good bounces in a row, steady apexes, over the centre",
+    bounds={f"bounce.{k}": v for k, v in BOUNDS.items()}, loss=bounce_loss, budget=100,
+    chains=2, t_start=1.0, t_end=0.01)
 
 
 def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float]:

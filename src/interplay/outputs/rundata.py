@@ -97,12 +97,16 @@ class RunData:
                 out[key] = (1 - a) * q0 + a * q1
         return out
 
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Axis-aligned box (lo, hi) in m around every animated system over the whole run
-        (static systems such as a 20 m floor would swamp the framing)."""
+    def bounds(self, at: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned box (lo, hi) in m around every animated system over the whole run, or
+        at the output frame nearest time ``at`` (s) (static systems such as a 20 m floor
+        would swamp the framing)."""
         pts = []
         for s in self.shapes:
             fr = self.frames.get(s.name, {})
+            if at is not None and len(fr.get("t", ())):
+                i = int(np.argmin(np.abs(np.asarray(fr["t"], dtype=float) - at)))
+                fr = {k: v[i:i + 1] for k, v in fr.items()}
             if s.form == "body" and "position" in fr and len(fr["position"]):
                 r = float(np.max(np.linalg.norm(s.verts, axis=1))) if s.verts is not None else 0
                 p = fr["position"]

@@ -7,8 +7,8 @@ The leap: stand, crouch, tip forward over the toes (ankles dorsiflex with balanc
 the centre of mass is far enough ahead, then a timed hip-knee-ankle extension with an arm
 swing, a tuck so the feet clear the edge, and a layout (swan dive) for the rest. The defaults
 of ``JumperParams`` were found by ``tune_leap`` (simulated annealing over the leap's parameters
-with the cord disabled; ``python -m interplay.scenes.bungee``), rounded and checked again;
-docs/figures.md has the search and its result.
+with the cord disabled; ``interplay tune bungee`` runs it on every core), rounded and checked
+again; docs/figures.md has the search and its result.
 """
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..control import behaviours as B
+from ..control.search import Search
 from ..control.fsm import Controller, State, Transition
 from ..geometry.anthropometry import SEGMENTS, BodyParams
 from ..geometry.setpieces import bridge
@@ -217,26 +218,30 @@ BOUNDS = {"depth": (0.3, 1.1), "lean": (0.0, 0.8), "lead": (0.0, 0.3), "hip": (-
 
 
 def tune_leap(evaluations: int = 150, seed: int = 0, start: JumperParams = JumperParams()):
-    """Simulated annealing over the leap parameters in TUNED (cord disabled); returns the best
-    JumperParams and the SearchResult."""
+    """Simulated annealing over the leap parameters in TUNED (cord disabled), one candidate at
+    a time in this process; returns the best JumperParams and the SearchResult. ``interplay
+    tune bungee --chains 1`` runs the same search (on the executor)."""
     from ..control.search import anneal
     res = anneal(lambda d: leap_loss(replace(start, **d)),
                  {k: getattr(start, k) for k in TUNED}, BOUNDS, evaluations, seed)
     return replace(start, **res.best), res
 
 
+def leap_search_loss(coupling: str, kw: dict) -> float:
+    """The leap's loss for ``interplay tune bungee``: the jumper's parameters in the build
+    keywords kw; the cord and the coupling play no part (the figure leaps alone)."""
+    return leap_loss(kw["params"].jumper)
+
+
+LEAP_SEARCH = Search("leap", "the leap off the deck (figure alone): clear the edge, rise, "
+                     "never touch the deck after takeoff",
+                     bounds={f"jumper.{k}": v for k, v in BOUNDS.items()},
+                     loss=leap_search_loss, budget=150, chains=4)
+
 SPEC = SceneSpec(
     "bungee", "a figure leaps off a bridge on a spring-mass bungee cord (two-way)", build,
     BungeeParams, couplings=("two-way", "one-way"), duration=8.0, fps=30.0,
-    integrators=("explicit", "implicit", "localglobal"),
+    integrators=("explicit", "implicit", "localglobal"), searches=(LEAP_SEARCH,),
     # beside him and a little above, 6.7 m off: he stays a third of the frame tall all the way
     camera=TrackingCamera("jumper", offset=(5.2, -4.0, 1.2), target_offset=(0.4, 0.0, -0.3),
                           fov_deg=38.0, smooth_s=0.35), key_time=3.4)
-
-
-if __name__ == "__main__":
-    import sys
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 150
-    best, res = tune_leap(n)
-    print(f"loss {res.loss:.4f} after {n} evaluations; {leap_trial(best)}")
-    print(", ".join(f"{k}={getattr(best, k):.3f}" for k in TUNED))

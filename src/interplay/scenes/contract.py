@@ -23,8 +23,8 @@ class SceneSpec:
     outputs.render.camera Camera or TrackingCamera; None: frame every system); key_time (s):
     the moment its figure shows (the ball in the net), the gallery's still; figures: result ->
     {label: value}, the scene's own key figures (the basketball's exit speed) for summaries
-    and compare tables; tune: its controller search (control/search.TuneProblem) for
-    ``interplay tune``, None for none.
+    and compare tables; searches: the ``control.search.Search``es ``interplay tune`` can run
+    on it (the first is the default).
     """
     name: str
     description: str
@@ -39,7 +39,7 @@ class SceneSpec:
     camera: object = None
     key_time: float | None = None
     figures: Callable | None = field(default=None, compare=False)
-    tune: object = field(default=None, compare=False)
+    searches: tuple = field(default=(), compare=False)
 
     @property
     def default_coupling(self) -> str:
@@ -79,6 +79,21 @@ class SceneSpec:
             raise SceneError(f"{self.name} supports only {_list(self.couplings)} coupling: "
                              "there is nothing to compare; use `interplay run "
                              f"{self.name}`")
+
+    def search(self, name: str | None = None):
+        """The Search called ``name`` (None: the scene's first); one line when there is none."""
+        if not self.searches:
+            from . import all_specs
+            have = [s.name for s in all_specs() if s.searches]
+            raise SceneError(f"{self.name} offers no search to tune; scenes with one: "
+                             f"{', '.join(have) or 'none'}")
+        if name is None:
+            return self.searches[0]
+        for s in self.searches:
+            if s.name == name:
+                return s
+        raise ParameterError(f"--search {name}: {self.name} has no such search; choose "
+                             f"{_list([s.name for s in self.searches])}")
 
     def check_fit(self):
         if self.standin is None or self.fit_time is None:

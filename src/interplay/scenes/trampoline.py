@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..control.bounce import BounceBalance, BounceParams, controller
-from ..control.bounce_search import TUNE
+from ..control.bounce_search import BOUNCE
 from ..outputs.render.camera import Camera
 from ..geometry.anthropometry import BodyParams
 from ..geometry.trampoline import BedParams, build_bed, frame_mesh
@@ -220,5 +220,5 @@ def figures(result) -> dict:
 SPEC = SceneSpec(
     "trampoline", "a gymnast bounces on a spring-mass trampoline (two-way)", build,
     TrampolineParams, couplings=("two-way", "hybrid", "one-way"), duration=20.0, fps=60.0,
-    integrators=("explicit",), tune=TUNE, figures=figures,
+    integrators=("explicit",), searches=(BOUNCE,), figures=figures,
     camera=Camera((2.6, -7.6, 2.6), (0.0, 0.0, 1.8), 40.0))
