@@ -52,7 +52,8 @@ class BounceParams:
     docstring): landing posture knee_land (rad; the ankles and hips bend by half of it so the
     hips stay over the ankles), lean (rad of extra ankle flexion: the body forward over the
     middle of the feet) and trunk (rad of extra hip flexion);
-    leg_omega (rad/s): the stance legs' servo frequency; thrust_delay (s) after touchdown;
+    leg_omega (rad/s): the stance legs' servo frequency, ankle_share (-) the ankles' share
+    of it on the bed; thrust_delay (s) after touchdown;
     power (-): the extension's velocity targets; ankle_push (rad, negative: plantarflexion);
     arm_swing (rad of shoulder abduction at takeoff: the arms rise sideways, so the two
     arms' angular momenta cancel and the swing does not tip her), arm_land (rad); foot
@@ -67,24 +68,30 @@ class BounceParams:
     under the feet a metre below the centre of mass, against the spin; k_arms (-): the share
     of the body's pitch spin the arms take in the air by circling (forward against a
     backward spin), so the trunk lands upright, a trampolinist's correction."""
-    knee_land: float = param(0.45, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
-    lean: float = param(0.1, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
-    trunk: float = param(0.0, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
-    leg_omega: float = param(12.0, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
-    thrust_delay: float = param(0.12, "s", ge=0.0, le=2.0, doc="after touchdown")
-    power: float = param(1.0, "-", gt=0.0, le=5.0, doc="the extension's speed")
-    ankle_push: float = param(0.2, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
-    arm_swing: float = param(2.8, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
-    arm_land: float = param(0.6, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
-    k_speed: float = param(0.3, "s", ge=0.0, le=5.0, doc="foot placement on speed")
-    k_place: float = param(0.3, "-", ge=0.0, le=5.0, doc="foot placement on offset")
-    k_lead: float = param(5.0, "rad/m", ge=0.0, le=50.0)
-    k_drift: float = param(0.3, "rad s/m", ge=0.0, le=20.0)
-    k_spin: float = param(0.02, "rad s/(kg m^2)", ge=0.0, le=1.0)
-    k_attitude: float = param(0.0, "-", ge=0.0, le=3.0)
-    k_turn: float = param(0.0, "m s/(kg m^2)", ge=-1.0, le=1.0)
-    k_hip_spin: float = param(0.0, "rad s/(kg m^2)", ge=-1.0, le=1.0)
-    k_arms: float = param(0.0, "-", ge=0.0, le=5.0)
+    knee_land: float = param(
+        0.14445817435485553, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
+    lean: float = param(-0.0488264489650417, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
+    trunk: float = param(-0.03840802227306958, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
+    leg_omega: float = param(
+        12.8848547499585, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
+    ankle_share: float = param(
+        0.7741162175548496, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
+    thrust_delay: float = param(0.16237907246390273, "s", ge=0.0, le=2.0, doc="after touchdown")
+    power: float = param(0.5841121639613117, "-", gt=0.0, le=5.0, doc="the extension's speed")
+    ankle_push: float = param(0.35920869840470787, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
+    arm_swing: float = param(3.1, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
+    arm_land: float = param(
+        0.003616482133918858, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
+    k_speed: float = param(0.6, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+    k_place: float = param(
+        0.46001672902920826, "-", ge=0.0, le=5.0, doc="foot placement on offset")
+    k_lead: float = param(4.970550615473857, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.08162544824107555, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.0164970699297445, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.04171894873496466, "-", ge=0.0, le=3.0)
+    k_turn: float = param(0.003324037518460548, "m s/(kg m^2)", ge=-1.0, le=1.0)
+    k_hip_spin: float = param(-0.06, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    k_arms: float = param(0.05108273094290473, "-", ge=0.0, le=5.0)
 
     def validated(self) -> "BounceParams":
         for f in fields(self):
@@ -100,12 +107,12 @@ class BounceParams:
 
 
 #: the search's box: name -> (low, high), in the units above
-BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4), "leg_omega": (6.0, 20.0),
-          "thrust_delay": (0.0, 0.3), "power": (0.3, 2.0), "ankle_push": (-0.6, 0.4),
-          "arm_swing": (1.5, 3.1), "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6),
-          "k_place": (0.0, 1.0), "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5),
-          "k_spin": (0.0, 0.05), "k_attitude": (0.0, 1.2),
-          "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
+BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4),
+          "leg_omega": (6.0, 20.0), "ankle_share": (0.05, 1.0), "thrust_delay": (0.0, 0.3),
+          "power": (0.3, 2.0), "ankle_push": (-0.6, 0.4), "arm_swing": (1.5, 3.1),
+          "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6), "k_place": (0.0, 1.0),
+          "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5), "k_spin": (0.0, 0.05),
+          "k_attitude": (0.0, 1.2), "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
           "k_arms": (0.0, 1.5)}
 
 
@@ -114,6 +121,10 @@ def controller(p: BounceParams) -> Controller:
     from her first apex)."""
     p = p.validated()
     legs = (("hip", p.leg_omega), ("knee", p.leg_omega), ("ankle", p.leg_omega))
+    # on the bed the ankles may be softer: a limp ankle puts no torque into the bed, so the
+    # bed's push runs from the foot up the leg, nearer the centre of mass
+    stance = (("hip", p.leg_omega), ("knee", p.leg_omega),
+              ("ankle", p.ankle_share * p.leg_omega))
     flight = State("flight", pose=(("hip", 0.0), ("knee", 0.05), ("ankle", -0.3), ("waist", 0.0),
                                    ("neck", 0.0), ("shoulder_flex", 0.0),
                                    ("shoulder_abd", p.arm_swing), ("elbow", 0.05),
@@ -125,7 +136,7 @@ def controller(p: BounceParams) -> Controller:
                                      ("shoulder_abd", p.arm_land), ("elbow", 0.1)),
                     gains=legs, support=True, blend=0.4,
                     transitions=(Transition("foot_contact", "absorb"),))
-    absorb = State("absorb", gains=legs, support=True, blend=0.0,
+    absorb = State("absorb", gains=stance, support=True, blend=0.0,
                    transitions=(Transition("time", "thrust", p.thrust_delay),
                                 Transition("no_foot_contact", "flight")))
     # the extension keeps the trunk's tilt in the world (trunk + lean, forward): the hips open
@@ -140,7 +151,7 @@ def controller(p: BounceParams) -> Controller:
                              ("ankle", -EXTEND * p.power * (0.5 * p.knee_land + p.lean
                                                             - p.ankle_push)),
                              ("shoulder_abd", 8.0)),
-                   gains=legs, support=True, blend=0.0,
+                   gains=stance, support=True, blend=0.0,
                    transitions=(Transition("no_foot_contact", "flight"),))
     return Controller((flight, descend, absorb, thrust), start="descend")
 

@@ -166,7 +166,7 @@ HAND_START = {"knee_land": 0.2, "lean": 0.0, "trunk": 0.0, "leg_omega": 12.0,
               "thrust_delay": 0.12, "power": 1.0, "ankle_push": 0.2, "arm_swing": 2.8,
               "arm_land": 0.6, "k_speed": 0.3, "k_place": 0.3, "k_lead": 5.0,
               "k_drift": 0.3, "k_spin": 0.02, "k_attitude": 0.0, "k_turn": 0.0,
-              "k_hip_spin": 0.0, "k_arms": 0.0}
+              "k_hip_spin": -0.03, "k_arms": 0.0, "ankle_share": 1.0}
 
 
 def start_sets(values: dict = HAND_START) -> list[str]:
@@ -177,7 +177,7 @@ def start_sets(values: dict = HAND_START) -> list[str]:
 BOUNCE = Search(
     "bounce", "the bounce controller: good bounces in a row, steady apexes, over the centre",
     bounds={f"bounce.{k}": v for k, v in BOUNDS.items()}, loss=bounce_loss, budget=100,
-    chains=2, t_start=1.0, t_end=0.01)
+    chains=4, t_start=1.0, t_end=0.01, step=0.1)
 
 
 def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float]:
