@@ -49,6 +49,10 @@ import interplay  # noqa: E402
 from interplay.errors import StabilityError  # noqa: E402
 from interplay.geometry.net import net_knots  # noqa: E402
 from interplay.io.atomic import atomic_path  # noqa: E402
+
+import sys  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parent))
+from common import calibration  # noqa: E402
 from interplay.scenes import basketball as B  # noqa: E402
 
 DURATION = 1.5  # s, the scene's default length
@@ -312,7 +316,7 @@ def machine() -> dict:
             "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
             "NUMBA_THREADING_LAYER": os.environ.get("NUMBA_THREADING_LAYER"),
             "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS"),
-            "loadavg_start": list(os.getloadavg()), **source()}
+            "loadavg_start": list(os.getloadavg()), "calibration": calibration(), **source()}
 
 
 def source() -> dict:

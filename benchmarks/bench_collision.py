@@ -15,17 +15,15 @@ Figures are medians over --runs runs (each --steps steps) after a warm-up that c
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import statistics
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).parent))
+import common  # noqa: E402  (thread settings, machine facts, the JSON writer)
 
-os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+import numpy as np  # noqa: E402
 
 THICKNESS = 0.01  # m
 
@@ -125,14 +123,8 @@ def main(argv=None):
             row[k] = {"median": statistics.median(vals), "min": min(vals), "samples": vals}
         out[name] = row
         print(name, {k: round(row[k]["median"], 3) for k in keys}, flush=True)
-    out["machine"] = {"cpus": os.cpu_count(),
-                      "numba_threading_layer": os.environ.get("NUMBA_THREADING_LAYER")}
-    from interplay.io.atomic import atomic_path
-    dest = Path(args.out) / "bench_collision.json"
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(dest) as tmp:
-        Path(tmp).write_text(json.dumps(out, indent=2))
-    print("wrote", dest)
+    out["machine"] = common.machine()
+    print("wrote", common.write_json(args.out, "bench_collision.json", out))
 
 
 if __name__ == "__main__":

@@ -15,22 +15,19 @@ Run: ``.venv/bin/python benchmarks/bench_outputs.py --out out/bench [--quick]``.
 """
 from __future__ import annotations
 
-import os
+import sys
+from pathlib import Path
 
-os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")  # before numba: DESIGN.md
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(Path(__file__).parent))
+import common  # noqa: E402  (thread settings before numba, machine facts, the JSON writer)
 
 import argparse  # noqa: E402
-import json  # noqa: E402
-import platform  # noqa: E402
 import statistics  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from interplay.io.atomic import atomic_path  # noqa: E402
 from interplay.outputs.rundata import RunData, Shape, from_result  # noqa: E402
 
 SIZE = (1280, 720)
@@ -111,9 +108,7 @@ def main(argv=None):
     duration = 0.5 if args.quick else 1.5
     runs = {"basketball": basketball_run(duration), "cloth64": cloth_run(duration=duration)}
     report = {"what": "render+encode per frame at 1280x720, export per output frame",
-              "machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
-                          "python": platform.python_version(),
-                          "load_average": list(os.getloadavg())},
+              "machine": common.machine(),
               "workloads": {}}
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
@@ -131,10 +126,7 @@ def main(argv=None):
         report["gl_renderer"] = gl_context().info["GL_RENDERER"]
     except Exception as e:  # the numbers above already say whether GL worked
         report["gl_renderer"] = str(e)
-    out = Path(args.out) / "bench_outputs.json"
-    with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(report, indent=2))
-    print(f"wrote {out}")
+    print(f"wrote {common.write_json(args.out, 'bench_outputs.json', report)}")
 
 
 if __name__ == "__main__":

@@ -101,3 +101,57 @@ def test_floor_bounce_keeps_its_restitution():
     assert 0.785 <= e_fine <= 0.81
     assert e_coarse == pytest.approx(e_fine, abs=0.03)
     assert top == pytest.approx(1.0 * e_coarse ** 2, abs=0.01)
+
+
+def on_floor(shell: bool, v0=(0.0, 0.0, 0.0), seconds=1.0, h=1e-3, mu=0.6, eps=0.05):
+    """The basketball's ball on its floor (1e5 N/m, 40 N s/m, friction mu, eps m/s) set down
+    touching it at rest or sliding at v0 (m/s) without spin; returns (track, force log)."""
+    from interplay.interactions.contact import ContactParams, SpherePlaneContact
+    from interplay.scene import Scene
+    from interplay.systems.static import StaticPlane
+    scene = Scene("floor", duration=seconds, fps=100, coupling_dt=h)
+    p = SphereParams(shell=shell, dt=h)
+    ball = scene.add(Sphere("ball", p, position=(0.0, 0.0, p.radius), velocity=v0))
+    floor = scene.add(StaticPlane("floor", height=0.0, size=15.0))
+    law = ContactParams(stiffness=1e5, damping=40.0, friction=mu, eps=eps, thickness=0.0)
+    scene.connect(SpherePlaneContact("ball-floor", ball, floor, law))
+    scene.primary = ball
+    r = scene.simulate()
+    return r.tracks["ball"], r.logs["ball-floor"]
+
+
+def test_a_ball_set_down_on_the_floor_rests():
+    """Issue 22 item 5: set down touching the floor, it is in contact every step, with no
+    vertical speed, carried by exactly its weight, at exactly its radius. Before the contact
+    kept a skin above the plane, the law's spring on top of the constraint force lifted it off
+    every other step: it hopped at up to 5.6 cm/s, pressing 1.035 m g on average."""
+    tr, log = on_floor(shell=True)
+    m, g = SphereParams().mass, 9.81
+    assert log.active.all()
+    assert np.abs(tr.xdot[:, 2]).max() < 1e-12
+    assert log.force[:, 2] == pytest.approx(m * g, rel=1e-12)
+    assert tr.x[:, 2] == pytest.approx(SphereParams().radius, abs=1e-12)
+
+
+@pytest.mark.parametrize("shell,k,ratio", [(False, 7 / 2, 5 / 7), (True, 5 / 2, 3 / 5)])
+def test_a_sliding_ball_starts_rolling_when_and_as_fast_as_the_closed_form(shell, k, ratio):
+    """A ball sliding at v0 without spin: Coulomb friction mu m g slows the slip at
+    mu g k (k = 1 + m r^2 / I: 7/2 solid, 5/2 shell) until it rolls at 5/7 v0 (solid) or 3/5
+    v0 (shell). The regularised law is full Coulomb down to a slip of eps, reached at
+    (v0 - eps) / (mu g k): within two steps of it; the rolling speed within 1e-3 v0 (the
+    viscous tail below eps decays at mu g k / eps, 300/s, and the friction cap of the held
+    force lets the slip's last 1e-3 go in the tail), and it then rolls on at that speed."""
+    v0, mu, eps, h, g = 2.0, 0.6, 0.05, 1e-3, 9.81
+    tr, _ = on_floor(shell=shell, v0=(v0, 0.0, 0.0), seconds=0.5, h=h, mu=mu, eps=eps)
+    r = SphereParams().radius
+    # the track's state: position and orientation (w, x, y, z); its rate: velocity and the
+    # quaternion's; world angular velocity = 2 vec(qdot q*) = 2 (w vdot - wdot v - vdot x v)
+    w, v = tr.x[:, 3], tr.x[:, 4:7]
+    wd, vd = tr.xdot[:, 3], tr.xdot[:, 4:7]
+    omega = 2.0 * (w[:, None] * vd - wd[:, None] * v - np.cross(vd, v))
+    slip = tr.xdot[:, 0] - r * omega[:, 1]  # the contact point's speed along +x
+    t_eps = tr.t[np.argmax(slip < eps)]
+    assert t_eps == pytest.approx((v0 - eps) / (mu * g * k), abs=2 * h)
+    end = tr.t > 0.3
+    assert tr.xdot[end, 0] == pytest.approx(ratio * v0, abs=1e-3 * v0)
+    assert np.ptp(tr.xdot[end, 0]) < 1e-6

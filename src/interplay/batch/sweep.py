@@ -55,7 +55,8 @@ def run_variant(task: VariantTask) -> dict:
         summary = json.loads((part / "summary.json").read_text())  # the row: saved data
         timings = {"simulate_s": result.total_s, **{k: v for k, v in result.timings().items()
                                                      if k in ("primary_pass_s",
-                                                              "secondary_pass_s")},
+                                                              "secondary_pass_s",
+                                                              "compile_s")},
                    "outputs_s": time.perf_counter() - t1,
                    **{k: x for k, x in options.timings.items() if k.endswith("_s")}}
         row.update(status="ok", exit=0, error=None, **figures_of(summary, result.main))

@@ -10,22 +10,11 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 
 from ..io.atomic import atomic_path
+from ..result import finite
 
 ROW_FILE = "variant.json"  # in each variant's folder: its row (written last: it marks it done)
-
-
-def finite(o):
-    """o with every non-finite float replaced by None (strict JSON)."""
-    if isinstance(o, float):
-        return o if math.isfinite(o) else None
-    if isinstance(o, dict):
-        return {k: finite(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [finite(v) for v in o]
-    return o
 
 
 def figures_of(summary: dict, main: str | None) -> dict:

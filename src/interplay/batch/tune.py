@@ -23,8 +23,8 @@ from pathlib import Path
 from ..control.search import anneal_batched, check_budget
 from ..errors import InterplayError, ParameterError
 from ..io.atomic import atomic_path
+from ..result import finite
 from .executor import Failure, guarded, worker_info
-from .table import finite
 from .variants import RunRequest, default_of, run_id
 
 LOG = "evaluations.jsonl"

@@ -201,15 +201,20 @@ def run_scene(spec, mode, kw, quiet=True, force=False, checkpointer=None, resume
     """Build and simulate one scene in one coupling mode (checked against its spec).
     given: what the command line set ("--dt 1e-9, --set net.loops=40"), named in front of
     an error the build or the run raises (a stability bound, a cost), since it is the cause."""
-    from .progress import PassProgress
+    from ..coupling import compilation
+    from .progress import CompileNotice, PassProgress
+    notice, c0 = CompileNotice(quiet), compilation.seconds()
     try:
-        scene = build_scene(spec, mode, kw)
-        try:
-            return scene.simulate(progress=PassProgress(scene.duration, quiet), force=force,
-                                  checkpointer=checkpointer, resume=resume)
-        except MemoryError:
-            raise CostError(f"{spec.name}: out of memory while simulating; shorten "
-                            "--duration, lower --fps, or lower the element counts") from None
+        with compilation.watching(notice):
+            scene = build_scene(spec, mode, kw)
+            try:
+                result = scene.simulate(progress=PassProgress(scene.duration, quiet),
+                                        force=force, checkpointer=checkpointer, resume=resume)
+            except MemoryError:
+                raise CostError(f"{spec.name}: out of memory while simulating; shorten "
+                                "--duration, lower --fps, or lower the element counts") from None
+        notice.finish(compilation.seconds() - c0)
+        return result
     except InterplayError as e:
         if given:
             raise type(e)(f"with {given}: {e}") from None
@@ -303,7 +308,7 @@ def cmd_run(args, console):
     from .text import print_run
     print_run(console, result)
     for p in paths:
-        console.print(f"wrote {p}")
+        console.print(f"wrote {p}", markup=False, soft_wrap=True)
 
 
 def cmd_compare(args, console):
@@ -331,7 +336,7 @@ def cmd_fit(args, console):
     out = Path(args.out or f"out/{args.scene}") / "standin_fit.json"
     with atomic_path(out) as tmp:
         tmp.write_text(json.dumps(fit, indent=2))
-    console.print(f"wrote {out}")
+    console.print(f"wrote {out}", markup=False, soft_wrap=True)
 
 
 def _vec(v):

@@ -26,7 +26,7 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
     reference = results.get("two-way")
     one_way_stable = (not any(results["one-way"].warnings)) if "one-way" in results else None
     two_way_cost = reference.work if reference is not None else None
-    wall = reference.total_s if reference is not None else None
+    wall = reference.total_s - reference.compile_s if reference is not None else None
     rows, paths = {}, []
     for mode, r in results.items():
         summary = scene_summary(spec, r, one_way_stable=one_way_stable,
@@ -50,7 +50,7 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
         paths += write_compare_outputs(results, out, rows, advice, options)
     _print_table(console, rows, advice)
     for p in paths:
-        console.print(f"wrote {p}")
+        console.print(f"wrote {p}", markup=False, soft_wrap=True)
     return report
 
 

@@ -114,7 +114,7 @@ def cmd_sweep(args, console) -> int:
                   + (f", {c['error']} failed (see sweep.csv)" if c["error"] else ""),
                   markup=False)
     for p in (out / "sweep.csv", out / "sweep.json", sheet):
-        console.print(f"wrote {p}", markup=False)
+        console.print(f"wrote {p}", markup=False, soft_wrap=True)
     return 1 if c["error"] else 0
 
 
@@ -138,5 +138,5 @@ def cmd_tune(args, console) -> int:
     console.print(f"run it: interplay run {doc['scene']} "
                   + " ".join(f"--set {s}" for s in (*base.sets, *doc["set"])), markup=False,
                   soft_wrap=True)
-    console.print(f"wrote {out / 'tune.json'}", markup=False)
+    console.print(f"wrote {out / 'tune.json'}", markup=False, soft_wrap=True)
     return 0

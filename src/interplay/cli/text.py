@@ -19,7 +19,9 @@ def print_run(console, result):
     t = result.timings()
     console.print(f"[bold]{result.scene}[/bold] ({result.coupling}): "
                   f"{result.duration:.2f} s simulated; primary debug cycle "
-                  f"{t['primary_pass_s']:.3f} s, total {t['total_s']:.3f} s")
+                  f"{t['primary_pass_s']:.3f} s, total {t['total_s']:.3f} s"
+                  + (f" of which {t['compile_s']:.1f} s compiling kernels (first run only)"
+                     if t["compile_s"] >= 0.5 else ""))
     table = Table("interaction", "mode", "contact (s)", "force min/max/mean (N)",
                   "accel. min/max/mean (m/s^2)")
     for s in result.interaction_stats():

@@ -234,7 +234,6 @@ def fly(fig: Figure, standin, level: float, duration: float, h: float = 2e-3,
 
 
 # --- the search (``python -m interplay.control.dive``) ------------------------------------------
-TUNED = ("lean", "lead", "hip", "power", "arm_swing", "reach", "pike", "open", "spot")
 BOUNDS = {"lean": (0.0, 0.8), "lead": (0.0, 0.3), "hip": (-0.2, 1.4), "power": (0.5, 2.0),
           "arm_swing": (1.0, 3.0), "reach": (0.0, 0.5), "pike": (1.2, 2.1),
           "open": (1.5, 3.1), "spot": (0.0, 0.6)}
@@ -257,22 +256,12 @@ def dive_loss(trial: Trial, edge: float) -> float:
             + 2.0 * max(0.0, CLEAR - (e.point[0] - edge)) + min(50.0 * trial.touched, 20.0))
 
 
-def tune(make, edge: float, level: float, evaluations: int = 150, seed: int = 0,
-         start: DiveParams = DiveParams(), duration: float = 5.0, **anneal_kw):
-    """Simulated annealing (control/search.py ``anneal``, its settings in anneal_kw) over
-    TUNED, each evaluation the dive and its NUDGES flown in air to the water (no stand-in is
-    needed before the entry). make(p) -> Figure builds the diver on his platform. Returns the
-    best DiveParams and the SearchResult."""
-    from .search import anneal
-
-    def loss(d):
-        total = 0.0
-        for nudge in NUDGES:
-            q = replace(start, **d)
-            q = replace(q, **{k: getattr(q, k) + dv for k, dv in nudge})
-            total += dive_loss(fly(make(q), None, level, duration), edge)
-        return total / len(NUDGES)
-
-    res = anneal(loss, {k: getattr(start, k) for k in TUNED}, BOUNDS, evaluations, seed,
-                 **anneal_kw)
-    return replace(start, **res.best), res
+def nudged_loss(make, p: DiveParams, edge: float, level: float, duration: float = 5.0) -> float:
+    """dive_loss averaged over the dive p and its NUDGES, each flown in air to the water (no
+    stand-in is needed before the entry), so the optimum is not a knife edge. make(p) ->
+    Figure builds the diver on his platform."""
+    total = 0.0
+    for nudge in NUDGES:
+        q = replace(p, **{k: getattr(p, k) + dv for k, dv in nudge})
+        total += dive_loss(fly(make(q), None, level, duration), edge)
+    return total / len(NUDGES)

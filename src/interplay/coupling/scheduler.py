@@ -36,6 +36,7 @@ import numpy as np
 from ..errors import CostError, SceneError, StabilityError
 from ..systems.base import Role, substeps
 from . import checkpoint as C
+from . import compilation
 from .forcelog import ForceLog
 from .track import Track, TrackRecorder
 
@@ -50,7 +51,8 @@ class Pass:
     played: list = field(default_factory=list)
     actions: list = field(default_factory=list)  # (interaction, role) role: both|secondary|standin
     record: list = field(default_factory=list)   # live systems whose full-rate track is kept
-    wall_s: float = 0.0
+    wall_s: float = 0.0  # its wall time (s) without compilation: the debug-cycle time
+    compile_s: float = 0.0  # wall time (s) it spent compiling or loading Numba kernels
     steps: int = 0
     work: float = 0.0  # state values advanced: substeps x values, summed over live systems
     h: float = 0.0
@@ -63,7 +65,8 @@ class Pass:
     def describe(self) -> dict:
         """The pass as data (summary.json's timings)."""
         return {"systems": [s.name for s in self.live], "played": [s.name for s in self.played],
-                "wall_s": self.wall_s, "steps": self.steps, "work": self.work,
+                "wall_s": self.wall_s, "compile_s": self.compile_s, "steps": self.steps,
+                "work": self.work,
                 "coupling_dt_s": self.h,
                 "substep_s": dict(self.dts)}
 
@@ -347,7 +350,7 @@ class Runner:
             self.warnings.append(f"duration {self.duration:g} s is not a whole number of "
                                  f"coupling steps of {h:g} s: pass {p.label} runs {n} steps, "
                                  f"{n * h:.9g} s")
-        p.h, p.steps, p.wall_s = h, n, 0.0
+        p.h, p.steps, p.wall_s, p.compile_s = h, n, 0.0, 0.0
         p.work = float(n * sum(substeps(h, p.dts[s.name]) * s.generalized_state()[0].size
                                for s in p.live))
         self.monitor = Monitor(p.live)
@@ -411,6 +414,14 @@ class Runner:
                 it.restore(self.snaps["now"][it.name])
         deferred = []
         t0 = wallclock.perf_counter() - p.wall_s
+        c_base, c0 = p.compile_s, compilation.seconds()
+
+        def elapsed() -> float:
+            # the pass's wall time so far without the kernels' compilation (a first run's),
+            # which goes to p.compile_s
+            spent = compilation.seconds() - c0
+            p.compile_s = c_base + spent
+            return wallclock.perf_counter() - t0 - spent
         if self.ckpt is not None:
             self.ckpt.start(st.k * h)
         first = st.k
@@ -429,7 +440,7 @@ class Runner:
             # last step (a figure's wrenches), which capture() does not keep
             if self.ckpt is not None and k > first and self.ckpt.due(t):
                 st.k = k
-                p.wall_s = wallclock.perf_counter() - t0
+                p.wall_s = elapsed()
                 self.save()
             for s, tr in played_tracks:
                 s.set_generalized_state(*tr.sample(t))
@@ -468,7 +479,7 @@ class Runner:
                         raise _Unstable(s, w, t + h)
             if self.progress is not None and k % 500 == 0:
                 self.progress(p, t, wallclock.perf_counter() - t0)
-        p.wall_s = wallclock.perf_counter() - t0
+        p.wall_s = elapsed()
         if self.progress is not None:
             self.progress(p, self.duration, p.wall_s, done=True)
         for s, r in zip(p.record, recs):
@@ -504,7 +515,8 @@ class Runner:
                   "attempt": self.attempt, "failed_at": self.failed_at,
                   "warnings": self.warnings, "extra": self.extra,
                   "passes": [{"label": q.label, "dts": q.dts, "wall_s": q.wall_s,
-                              "steps": q.steps, "h": q.h, "work": q.work}
+                              "compile_s": q.compile_s, "steps": q.steps, "h": q.h,
+                              "work": q.work}
                              for q in self.passes],
                   "systems": [s.name for s in self.systems]}
         self.ckpt.save(header, a, self.state.k * p.h)
@@ -520,6 +532,7 @@ class Runner:
         for q, saved in zip(self.passes, header["passes"]):
             q.dts.update(saved["dts"])
             q.wall_s, q.steps, q.h = saved["wall_s"], saved["steps"], saved["h"]
+            q.compile_s = saved["compile_s"]
             q.work = saved["work"]
         for s in self.systems:
             s.restore(C.take(a, f"sys/{s.name}"))

@@ -25,13 +25,17 @@ from .base import Interaction
 class ContactParams:
     """stiffness c_s (N/m), damping c_d (N s/m), friction mu (-), eps: the slip speed (m/s)
     below which friction is viscous; thickness: contact skin, e.g. a cord's radius (m);
-    constraint: include the constraint term f_c."""
+    constraint: include the constraint term f_c; skin (a sphere on a plane): how far above
+    the plane a contact is kept, where only the constraint force, lightened, acts, so that a
+    resting ball rests inside its contact instead of leaving it every other step."""
     stiffness: float = param(2.0e3, "N/m", ge=1e-6, le=1e9, doc="penalty stiffness c_s")
     damping: float = param(2.0, "N s/m", ge=0.0, le=1e7, doc="penalty damping c_d")
     friction: float = param(0.5, "-", ge=0.0, le=10.0, doc="Coulomb coefficient mu")
     eps: float = param(0.05, "m/s", ge=1e-6, le=100.0, doc="slip speed of full friction")
     thickness: float = param(0.003, "m", ge=0.0, le=1.0, doc="contact skin")
     constraint: bool = param(True, doc="include the constraint force f_c")
+    skin: float = param(0.002, "m", ge=0.0, le=1.0, doc="sphere on a plane: contact kept "
+                        "this far above it")
 
     def validated(self, owner: str) -> "ContactParams":
         require_positive(owner, "contact stiffness", self.stiffness, "N/m")
@@ -151,7 +155,7 @@ class SpherePlaneContact(Interaction):
     def exchange(self, to_primary, to_secondary):
         inertia = 1.0 / self.ball.inverse_inertias()[0, 0, 0]  # a sphere's is isotropic
         on = sphere_plane(_ball(self.ball, self.radius), inertia, self.height, self._law,
-                          self._h, self._wrench)
+                          self._h, self.p.skin, self._wrench)
         if on and to_primary:
             # the normal penalty's Jacobians let the ball integrate the bounce implicitly
             self.ball.apply(0, self._wrench[:3], self._wrench[3:], dfdx=self._dfdx,

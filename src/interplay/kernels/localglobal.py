@@ -465,8 +465,50 @@ def _dot(a, b):
     return s
 
 
+#: the most extra rounds of iterations (each of Settings.iters) a step gets when it would add
+#: energy, before its velocities are scaled back instead
+GUARD_ROUNDS = 3
+
+
 @njit(cache=True)
-def localglobal_steps(net, fext, pre, hist, settings, h, nsteps, cols, phis):
+def network_energy(net) -> float:
+    """(J) the network's kinetic energy, its springs' stretch energy (slack cords none), its
+    anchors' springs' and the gravitational energy (zero at z = 0 for gravity along -z)."""
+    x, v, m, fixed = net.pts
+    si, sj, l0, k, tension_only = (net.springs.i, net.springs.j, net.springs.rest,
+                                   net.springs.k, net.springs.tension_only)
+    a_idx, a_pos, a_k, _ = net.anchors
+    e = 0.0
+    for i in range(x.shape[0]):
+        if not fixed[i]:
+            e += m[i] * (0.5 * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+                         - net.gravity[0] * x[i, 0] - net.gravity[1] * x[i, 1]
+                         - net.gravity[2] * x[i, 2])
+    for s in range(si.shape[0]):
+        d = np.sqrt((x[si[s], 0] - x[sj[s], 0]) ** 2 + (x[si[s], 1] - x[sj[s], 1]) ** 2
+                    + (x[si[s], 2] - x[sj[s], 2]) ** 2) - l0[s]
+        if not (tension_only[s] and d < 0.0):
+            e += 0.5 * k[s] * d * d
+    for j in range(a_idx.shape[0]):
+        i = a_idx[j]
+        e += 0.5 * a_k[j] * ((x[i, 0] - a_pos[j, 0]) ** 2 + (x[i, 1] - a_pos[j, 1]) ** 2
+                             + (x[i, 2] - a_pos[j, 2]) ** 2)
+    return e
+
+
+@njit(cache=True)
+def _held_work(x, xn, fext, fid) -> float:
+    """(J) the work of the held external forces over the step from xn to x."""
+    w = 0.0
+    for i in range(x.shape[0]):
+        if fid[i] >= 0:
+            for r in range(3):
+                w += fext[i, r] * (x[i, r] - xn[i, r])
+    return w
+
+
+@njit(cache=True)
+def localglobal_steps(net, fext, pre, hist, settings, h, nsteps, cols, phis, guard):
     """nsteps backward-Euler steps of h seconds of a springs.Network with fext (N) held;
     returns the iterations taken in all.
 
@@ -480,6 +522,14 @@ def localglobal_steps(net, fext, pre, hist, settings, h, nsteps, cols, phis):
     (``_sphere_contacts``); cols.impulses receives impulse, angular impulse and peak force (N).
     phis (2,) receives the objective (J s^2, up to a constant) at the last step's first guess
     and at its end, before any collider: how far the iterations got.
+
+    The energy guard: a converged backward-Euler step never adds energy beyond the held
+    forces' work (it is dissipative for convex spring energy), but a step cut short at
+    ``iters`` can (a stiff chain, k h^2/m ~ 5e3, climbed from -1.5 J to -0.2 J over 10 s at
+    10 iterations). A step whose network_energy exceeds the step start's plus the held forces'
+    work gets up to GUARD_ROUNDS more rounds of ``iters`` iterations; if it still would, its
+    velocities are scaled down to the allowed kinetic energy. guard (2,) counts the extra
+    rounds and the scaled steps (added to).
     """
     x, v, m, _ = net.pts
     si, sj, l0, tension_only = (net.springs.i, net.springs.j, net.springs.rest,
@@ -519,6 +569,7 @@ def localglobal_steps(net, fext, pre, hist, settings, h, nsteps, cols, phis):
         for r in range(7):
             impulses[j, r] = 0.0
     for step in range(nsteps):
+        e_start = network_energy(net)
         # the linear part: M (y + h alpha x_n) + h^2 (f + m g) + the anchors' pull and damping;
         # the first guess is y = x_n + h v_n
         for i in range(n):
@@ -556,10 +607,32 @@ def localglobal_steps(net, fext, pre, hist, settings, h, nsteps, cols, phis):
                 cn[s] = 0.0
         obj = Objective(fid, net.springs, u, cn, diag, base, hh, hb)
         total += _lbfgs(x, obj, pre, hist, (g, gn, q, z, xt), iters, tol, phis)
-        for i in range(n):
-            if fid[i] >= 0:
-                for r in range(3):
-                    v[i, r] = (x[i, r] - xn[i, r]) / h
+        phi_guess = phis[0]
+        for rounds in range(GUARD_ROUNDS + 1):
+            for i in range(n):
+                if fid[i] >= 0:
+                    for r in range(3):
+                        v[i, r] = (x[i, r] - xn[i, r]) / h
+            allowed = e_start + _held_work(x, xn, fext, fid)
+            excess = network_energy(net) - allowed
+            # round-off: the sums' terms are of the size of |e_start|
+            if excess <= 1e-10 * (abs(e_start) + abs(allowed)) + 1e-14:
+                break
+            if rounds < GUARD_ROUNDS:  # iterate on from where the step got to
+                guard[0] += 1
+                total += _lbfgs(x, obj, pre, hist, (g, gn, q, z, xt), iters, tol, phis)
+                continue
+            ke = 0.0
+            for i in range(n):
+                if fid[i] >= 0:
+                    ke += 0.5 * m[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+            scale = np.sqrt(max(ke - excess, 0.0) / ke) if ke > 0.0 else 0.0
+            for i in range(n):
+                if fid[i] >= 0:
+                    for r in range(3):
+                        v[i, r] *= scale
+            guard[1] += 1
+        phis[0] = phi_guess
         tau = (step + 1) * h
         for j in range(cols.centres.shape[0]):
             for r in range(3):

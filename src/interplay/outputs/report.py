@@ -149,7 +149,9 @@ def _timings(t, output_timings) -> str:
             for i, p in enumerate(t["passes"])]
     out = [f"<p>Primary debug-cycle time <b>{t['primary_pass_s']:.3f} s</b> (wall time until "
            f"the primary's motion is complete); secondary passes "
-           f"{t['secondary_pass_s']:.3f} s; total {t['total_s']:.3f} s.</p>",
+           f"{t['secondary_pass_s']:.3f} s; total {t['total_s']:.3f} s, of which "
+           f"{t['compile_s']:.2f} s compiling or loading Numba kernels (in no pass's wall "
+           "time; a first run compiles, later runs load the cache).</p>",
            _table(head, rows)]
     if output_timings:
         out.append(_table(["output", "wall (s)"],

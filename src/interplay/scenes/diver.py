@@ -21,7 +21,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..control.dive import DiveParams, diver, fly
+from ..control.dive import BOUNDS, DiveParams, diver, fly, nudged_loss
+from ..control.search import Search
 from ..errors import SceneError
 from ..geometry.basin import BasinParams, basin
 from ..interactions.buoyancy import BodyInWater, BuoyancyParams
@@ -147,14 +148,18 @@ def check(trial, area, depth: float):
             f"pool.depth is {depth:g} m; use pool.depth >= {need:.1f} m")
 
 
+def deck_of(pf: PlatformParams) -> tuple:
+    """The platform's top (x0, x1, y0, y1, z) in m: its front edge at EDGE."""
+    return (EDGE - pf.length, EDGE, -pf.width / 2, pf.width / 2, LEVEL + pf.height)
+
+
 def build(coupling: str = "hybrid", duration: float = 5.5, fps: float = 60.0,
           integrator: str | None = None, dt: float | None = None,
           params: DiverParams = DiverParams()) -> Scene:
     """The scene. dt overrides the pool's largest step (s); the pool has one integrator."""
     wp = params.water if dt is None else replace(params.water, dt=dt)
     pf, dive = params.platform, params.dive.validated()
-    top = LEVEL + pf.height
-    deck = (EDGE - pf.length, EDGE, -pf.width / 2, pf.width / 2, top)
+    deck = deck_of(pf)
     water = pool(params.pool, pf.overhang, wp)
     area = footprint(water)
 
@@ -233,31 +238,24 @@ def dive_figures(result) -> dict:
     return out
 
 
+def dive_search_loss(coupling: str, kw: dict) -> float:
+    """The dive's loss for ``interplay tune diver`` (control/dive.py ``nudged_loss``): the dive
+    in air to the water from this scene's platform; the water and the coupling play no part."""
+    params = kw["params"]
+    deck = deck_of(params.platform)
+    return nudged_loss(lambda q: diver(q, deck, STANCE_X, air_density=params.air_density,
+                                       level=LEVEL), params.dive.validated(), EDGE, LEVEL)
+
+
+# the shipped DiveParams: `interplay tune diver --seed 4` (one chain, step 0.2; docs/diver.md)
+DIVE_SEARCH = Search("dive", "the dive in air to the water: vertical, hands first, clear of "
+                     "the platform, for the dive and its nudges",
+                     bounds={f"dive.{k}": v for k, v in BOUNDS.items()},
+                     loss=dive_search_loss, budget=400, chains=1, step=0.2, t_start=0.24)
+
 SPEC = SceneSpec(
     "diver", "a diver enters a pool from a 10 m platform; a drag field stands in for the "
     "water, then his motion drives the splash (hybrid)", build, DiverParams,
     couplings=("hybrid", "two-way", "one-way"), duration=5.5, fps=60.0,
     camera=Camera(eye=(7.0, -15.0, 5.5), target=(1.5, 0.0, 5.0), fov_deg=45.0),
-    figures=dive_figures)
-
-
-def tune_dive(evaluations: int = 150, seed: int = 0, params: DiverParams = DiverParams(),
-              **anneal_kw):
-    """Search the dive's take-off, pike and opening (control/dive.py ``tune``) on this
-    scene's platform, in air, from params.dive; returns (DiveParams, SearchResult)."""
-    from ..control.dive import tune
-    pf = params.platform
-    deck = (EDGE - pf.length, EDGE, -pf.width / 2, pf.width / 2, LEVEL + pf.height)
-    return tune(lambda q: diver(q, deck, STANCE_X, air_density=params.air_density, level=LEVEL),
-                EDGE, LEVEL, evaluations, seed, params.dive, **anneal_kw)
-
-
-if __name__ == "__main__":
-    import sys
-    from ..control.dive import TUNED
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 150
-    step = float(sys.argv[3]) if len(sys.argv) > 3 else 0.25  # 0.1: refine around the defaults
-    best, res = tune_dive(n, int(sys.argv[2]) if len(sys.argv) > 2 else 0, step=step,
-                          t_start=0.3 * step / 0.25)
-    print(f"loss {res.loss:.4f} after {n} evaluations")
-    print(", ".join(f"{k}={getattr(best, k):.3f}" for k in TUNED))
+    figures=dive_figures, searches=(DIVE_SEARCH,))

@@ -166,6 +166,8 @@ class SpringNetwork(System):
         self.lg_solver = lg_solver
         self.lg_taken = 0  # iterations taken in the last advance
         self.lg_objective = np.zeros(2)  # the last step's objective at its first guess and end
+        # the energy guard's extra iteration rounds and velocity scalings so far
+        self.lg_guard = np.zeros(2, dtype=np.int64)
         self._lg = None  # the factored local/global matrix and what it was built from
         self._lg_pending = None  # a restored L-BFGS history waiting for its matrix
         self.lg_factorizations = 0
@@ -422,7 +424,7 @@ class SpringNetwork(System):
         self.lg_taken = LG.localglobal_steps(
             self.bundle(), self.fext, pre, history,
             LG.Settings(self.beta, self.lg_iterations, self.lg_tolerance), h / n, n, cols,
-            self.lg_objective)
+            self.lg_objective, self.lg_guard)
 
     def _explicit(self, h, n):
         """n symplectic-Euler steps of h s with the held forces, serial or parallel."""
@@ -518,7 +520,7 @@ class SpringNetwork(System):
         (with the matrix key they belong to), so a restore and a rerun repeat bit for bit."""
         snap = {"x": self.x.copy(), "v": self.v.copy(), "time": np.array(self.time),
                 "has_prev": np.array(self.has_prev), "xp": self.xp.copy(),
-                "vp": self.vp.copy()}
+                "vp": self.vp.copy(), "lg_guard": self.lg_guard.copy()}
         if self._lg is not None:
             snap["lg_key"] = np.array(self._lg[0][:3], dtype=float)
             snap["lg_solver"] = np.array(self._lg[0][3])
@@ -532,6 +534,7 @@ class SpringNetwork(System):
         self.time = float(snap["time"])
         self.has_prev = bool(snap["has_prev"])
         self.xp[:], self.vp[:] = snap["xp"], snap["vp"]
+        self.lg_guard[:] = snap["lg_guard"]
         self._lg_pending = None
         if "lg_key" in snap:
             h, alpha, beta = (float(v) for v in snap["lg_key"])
@@ -545,6 +548,13 @@ class SpringNetwork(System):
         elif self._lg is not None:  # captured before any local/global step: start afresh
             for a in self._lg[3]:
                 a[...] = 0
+
+    def extra_diagnostics(self) -> dict:
+        """Local/global: how often the energy guard acted (kernels/localglobal.py)."""
+        if self.integrator != "localglobal":
+            return {}
+        return {"energy_guard": {"extra_rounds": int(self.lg_guard[0]),
+                                 "scaled_steps": int(self.lg_guard[1])}}
 
     def frame(self):
         return {"points": self.x.copy()}
