@@ -173,11 +173,15 @@ class BounceBalance:
         self.out = np.zeros(len(joints))
 
     def capture(self) -> dict:
-        return {"out": self.out.copy()}
+        # the arms' inertia is measured at the first tick's pose: a resumed run keeps it
+        return {"out": self.out.copy(),
+                "arms": np.array([np.nan if self.arms is None else self.arms])}
 
     def restore(self, snap: dict):
         if snap:
             self.out[:] = snap["out"]
+            arms = float(np.asarray(snap["arms"]).ravel()[0])
+            self.arms = None if math.isnan(arms) else arms
 
     def offsets(self, fig, sensors) -> np.ndarray:
         d = fig.data
