@@ -67,7 +67,9 @@ def test_the_pass_wall_time_leaves_compilation_out_and_the_summary_reports_it():
     wall = time.perf_counter() - t0
     p = result.passes[0]
     t = result.timings()
-    assert p["compile_s"] > 0.05  # a kernel's compile takes tenths of a second, never 0
+    # a fresh kernel's compile is counted, never 0 (tenths of a second in a cold process; 0.04 s
+    # measured in a warm full-suite process, where a threshold of 0.05 s failed)
+    assert p["compile_s"] > 0.0
     assert t["compile_s"] == p["compile_s"]
     # the two add up to the pass's wall time, which is inside the whole run's
     assert p["wall_s"] + p["compile_s"] <= result.total_s <= wall
