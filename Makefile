@@ -29,6 +29,8 @@ $(STAMP): pyproject.toml | sysdeps
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
 	$(BIN)/pip install -q -e '.[test,bench,viewer]'
+	@echo "compiling every scene's kernels once, so that no first run waits for them:"
+	$(BIN)/interplay warm
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -36,8 +36,9 @@ def test_a_compile_is_counted_and_timed_and_a_second_call_is_not():
     wall = time.perf_counter() - t0
     n1, s1 = compilation.compiled(), compilation.seconds()
     assert n1 - n0 >= 1
-    # the compile is most of the first call (the call itself is nanoseconds), and no more
-    assert 0.5 * wall < s1 - s0 <= wall
+    # the compile is timed, and inside the first call (no timing threshold: a ratio of two
+    # wall times depends on the machine's load)
+    assert 0.0 < s1 - s0 <= wall
     kernel(np.ones(4), 0.5)
     assert compilation.compiled() == n1 and compilation.seconds() == s1
 
@@ -67,9 +68,7 @@ def test_the_pass_wall_time_leaves_compilation_out_and_the_summary_reports_it():
     wall = time.perf_counter() - t0
     p = result.passes[0]
     t = result.timings()
-    # a fresh kernel's compile is counted, never 0 (tenths of a second in a cold process; 0.04 s
-    # measured in a warm full-suite process, where a threshold of 0.05 s failed)
-    assert p["compile_s"] > 0.0
+    assert p["compile_s"] > 0.0  # the pass compiled the kernel: its time is counted
     assert t["compile_s"] == p["compile_s"]
     # the two add up to the pass's wall time, which is inside the whole run's
     assert p["wall_s"] + p["compile_s"] <= result.total_s <= wall

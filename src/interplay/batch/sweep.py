@@ -94,10 +94,10 @@ def finished(out: Path, v: Variant) -> dict | None:
 
 def warm(v: Variant):
     """Compile (or load) every Numba kernel the scene uses, once, here, before the workers
-    start: its build and a couple of output frames of its run. Workers then load the cache."""
+    start (batch/warm.py). Workers then load the cache."""
+    from .warm import warm_request
     try:
-        spec, coupling, kw = v.request.resolve()
-        spec.build(coupling, **dict(kw, duration=min(kw["duration"], 2.0 / kw["fps"]))).simulate()
+        warm_request(v.request)
     except Exception:  # noqa: BLE001 - the variant itself will report what went wrong
         pass
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from .. import params as P
 from ..errors import CostError, InterplayError, ParameterError, StabilityError
 from ..params import param
-from .sweep import add_parsers, cmd_sweep, cmd_tune
+from .sweep import add_parsers, cmd_sweep, cmd_tune, cmd_warm
 
 
 #: the smallest preview the captions fit in (the overlay's text is ~130 px wide, 34 px high)
@@ -349,7 +349,7 @@ def cmd_view(args, console):
 
 
 COMMANDS = {"list": cmd_list, "run": cmd_run, "compare": cmd_compare, "fit-standin": cmd_fit,
-            "view": cmd_view, "sweep": cmd_sweep, "tune": cmd_tune}
+            "view": cmd_view, "sweep": cmd_sweep, "tune": cmd_tune, "warm": cmd_warm}
 
 
 def _argv(argv):

@@ -1,5 +1,6 @@
-"""`interplay sweep` (a wedge of variants of one scene) and `interplay tune` (a scene's search),
-both on the executor: the local cores by default, a Ray cluster with --ray [ADDRESS].
+"""`interplay sweep` (a wedge of variants of one scene), `interplay tune` (a scene's search) and
+`interplay warm` (every scene's kernels compiled into the cache), on the executor: the local
+cores by default, a Ray cluster with --ray [ADDRESS] (sweep, tune).
 
 Everything is checked before anything runs: every variant's parameters (each is built once),
 the outputs, the workers; a mistake is one line and exit 2. A sweep exits 1 when a variant
@@ -51,6 +52,12 @@ def add_parsers(sub, scene_options, output_options):
                    help="chains annealed side by side, one candidate each per batch (the "
                         "result depends on K and the seed, not on --workers)")
     _executor_options(g)
+    warm = sub.add_parser("warm", help="compile every scene's kernels into Numba's cache on "
+                                       "every core, so that first runs do not wait")
+    warm.add_argument("scenes", nargs="*", help="the scenes (default: all)")
+    warm.add_argument("--workers", type=int, default=None, metavar="N",
+                      help="local worker processes (default: one per core)")
+    warm.add_argument("--quiet", action="store_true", help="no line per scene")
 
 
 def _executor_options(g):
@@ -140,3 +147,29 @@ def cmd_tune(args, console) -> int:
                   soft_wrap=True)
     console.print(f"wrote {out / 'tune.json'}", markup=False, soft_wrap=True)
     return 0
+
+
+def cmd_warm(args, console) -> int:
+    import time
+
+    from ..batch.executor import Failure, LocalPool
+    from ..batch.warm import tasks, warm_scene
+    todo = tasks(args.scenes)  # an unknown scene is one line here, before any worker starts
+    log = _log(args, console)
+    t0, failed = time.perf_counter(), 0
+    with LocalPool(args.workers) as pool:
+        # the first scene alone: the kernels most scenes share (springs, collision trees,
+        # rigid bodies) are then compiled once, not once per worker
+        done = [(0, r) for _, r in pool.map_unordered(warm_scene, todo[:1])]
+        rest = ((i + 1, r) for i, r in pool.map_unordered(warm_scene, todo[1:]))
+        for i, r in (*done, *rest):
+            t = todo[i]
+            if isinstance(r, Failure):
+                failed += 1
+                log(f"{t.scene} {t.coupling}: failed: {r.message}")
+            else:
+                log(f"{t.scene} {t.coupling}: {r['kernels']} kernels compiled, "
+                    f"{r['compile_s']:.1f} s compiling ({r['wall_s']:.1f} s)")
+    log(f"warmed {len(todo) - failed} of {len(todo)} scene couplings in "
+        f"{time.perf_counter() - t0:.1f} s on {pool.workers} workers")
+    return 1 if failed else 0

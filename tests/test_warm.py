@@ -1,0 +1,39 @@
+"""`interplay warm` fills Numba's cache so that a first run compiles nothing (issue 22 item 1;
+docs/first-run.md). Each step in its own process, as a user's would be, on an empty cache
+folder of the test's own (NUMBA_CACHE_DIR)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+
+def interplay(*argv, cache):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=SRC)
+    return subprocess.run([sys.executable, "-m", "interplay.cli.command", *argv], env=env,
+                          capture_output=True, text=True, timeout=600)
+
+
+def test_a_warmed_scene_runs_without_compiling(tmp_path):
+    cache = tmp_path / "numba-cache"
+    warm = interplay("warm", "flags", "--workers", "1", cache=cache)
+    assert warm.returncode == 0, warm.stderr
+    line = next(ln for ln in warm.stdout.splitlines() if ln.startswith("flags one-way:"))
+    assert int(line.split(":")[1].split()[0]) > 0  # an empty cache: it compiled
+    run = interplay("run", "flags", "--duration", "0.05", "--no-video", "--quiet", "--out",
+                    str(tmp_path / "run"), cache=cache)
+    assert run.returncode == 0, run.stderr
+    assert "compiling kernels" not in run.stderr
+    timings = json.loads((tmp_path / "run" / "summary.json").read_text())["timings"]
+    # loading the cached kernels takes the compiler lock too, for milliseconds each
+    assert timings["compile_s"] < 1.0
+
+
+def test_an_unknown_scene_is_one_line_before_any_worker_starts(tmp_path):
+    r = interplay("warm", "flgas", cache=tmp_path)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "flgas" in r.stderr
