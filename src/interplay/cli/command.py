@@ -133,6 +133,8 @@ def _parser():
     _scene_options(run)
     run.add_argument("--coupling", default=None,
                      help="two-way | one-way | hybrid (default: the scene's own)")
+    run.add_argument("--controller", default=None, metavar="FILE",
+                     help="a controller from `interplay tune` (its tune.json)")
     _resume_options(run)
     _output_options(run)
     cmp_ = sub.add_parser("compare", help="run the three coupling modes side by side")
@@ -160,6 +162,9 @@ def _build_kwargs(args):
         if not eq or not key.strip():
             raise ParameterError(f"--set {item[:80]}: expected KEY=VALUE")
         assignments[key.strip()] = value.strip()
+    if getattr(args, "controller", None):  # a tuned controller; --set still overrides it
+        from .controller import controller_sets
+        assignments = {**controller_sets(spec, args.controller), **assignments}
     try:
         params = P.apply(spec.params(), assignments)
     except ParameterError as e:

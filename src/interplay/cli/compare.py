@@ -55,9 +55,15 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
 
 
 def _figure(value) -> str:
+    """A key figure as table text: numbers to 3 places, lists item by item (a scene's
+    figures may also hold counts, names, nested lists and None for "not measured")."""
+    if value is None:
+        return "-"
     if isinstance(value, (list, tuple)):
-        return ", ".join(f"{v:.2f}" for v in value)
-    return f"{value:.3f}"
+        return ", ".join(f"{v:.2f}" if isinstance(v, float) else _figure(v) for v in value)
+    if isinstance(value, float):
+        return f"{value:.3f}"
+    return str(value)
 
 
 def _print_table(console, rows, advice):

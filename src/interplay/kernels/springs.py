@@ -396,10 +396,12 @@ def implicit_step(net, load, f, h, scheme, has_prev):
 
 @njit(cache=True)
 def max_strain(x, springs):
-    """Largest (l - l0) / l0 over all springs."""
+    """Largest (l - l0) / l0 over all springs (preloaded ones, l0 < 0, have no strain)."""
     si, sj, l0 = springs.i, springs.j, springs.rest
     best = -1.0
     for s in range(si.shape[0]):
+        if l0[s] <= 0.0:
+            continue
         e = _spring_vector(x, si[s], sj[s])[3] / l0[s] - 1.0
         if e > best:
             best = e

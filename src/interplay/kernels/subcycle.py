@@ -13,6 +13,7 @@ import numpy as np
 from numba import njit
 
 from .contact import Sphere, sphere_elements, THICKNESS
+from .part_contact import Touches, find_touches, touch_forces
 from .springs import Load, PointForces, implicit_step, network_forces, symplectic_update
 
 
@@ -105,4 +106,82 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
             implicit_step(net, sub_load, f, dt, scheme, has_prev or step > 0)
         else:
             # symplectic Euler on the forces already evaluated (internal, held, contacts)
+            symplectic_update(net.pts, f, dt)
+
+
+@njit(cache=True)
+def advance_with_parts(net, load, f, h, nsub, scheme, has_prev, parts):
+    """Advance the Network by h in nsub substeps with the rigid ``parts`` (a
+    kernels.part_contact.Parts, its candidates already found) evaluated against their
+    candidate elements at every substep along their predicted paths: as
+    ``advance_with_colliders``, for spheres, capsules and boxes. parts.impulses receives each
+    part's impulse, angular impulse about its centre of mass and peak force over the step;
+    parts.peak the largest total force of any substep."""
+    x = net.pts.x
+    m = net.pts.m
+    n = x.shape[0]
+    dt = h / nsub
+    k_parts = parts.impulses.shape[0]
+    nc = parts.start[k_parts]  # the step's candidates: at most 2 point entries each
+    out = PointForces(np.zeros(2 * nc, dtype=np.int64), np.zeros((2 * nc, 3)),
+                      np.zeros((2 * nc, 3, 3)), np.zeros((2 * nc, 3, 3)), np.zeros((2 * nc, 3)))
+    tc = Touches(np.zeros(nc, np.int64), np.zeros(nc, np.int64), np.zeros(nc, np.int64),
+                 np.zeros(nc), np.zeros(nc), np.zeros((nc, 3)), np.zeros((nc, 3)),
+                 np.zeros((nc, 3)), np.zeros((k_parts, 3)), np.zeros(n))
+    wrenches = np.zeros((k_parts, 6))
+    fe = np.empty_like(load.f)
+    ke = np.empty_like(load.kext)
+    de = np.empty_like(load.dext)
+    kv = np.empty_like(load.kvref)
+    sub_load = Load(fe, ke, de, kv)
+    acc = np.empty_like(x)
+    implicit = scheme.implicit
+    impulses = parts.impulses
+    impulses[:, :] = 0.0
+    parts.peak[0] = 0.0
+    received = parts.received
+    received[:] = 0.0
+    for step in range(nsub):
+        tau = step * dt
+        network_forces(net, load.f, f)
+        if implicit:
+            fe[:] = load.f
+            ke[:] = load.kext
+            de[:] = load.dext
+            kv[:] = load.kvref
+        cnt = find_touches(parts, tau, x, tc) if nc > 0 else 0
+        entries = 0
+        if cnt > 0:
+            for i in range(n):  # free accelerations, for the contacts' constraint term
+                for r in range(3):
+                    acc[i, r] = f[i, r] / m[i]
+            entries = touch_forces(parts, tc, cnt, net.pts, acc, dt, out, implicit, wrenches)
+            tx, ty, tz = 0.0, 0.0, 0.0
+            for j in range(k_parts):
+                for r in range(6):
+                    impulses[j, r] += wrenches[j, r] * dt
+                fmag = np.sqrt(wrenches[j, 0] ** 2 + wrenches[j, 1] ** 2 + wrenches[j, 2] ** 2)
+                if fmag > impulses[j, 6]:
+                    impulses[j, 6] = fmag
+                tx += wrenches[j, 0]
+                ty += wrenches[j, 1]
+                tz += wrenches[j, 2]
+            parts.peak[0] = max(parts.peak[0], np.sqrt(tx * tx + ty * ty + tz * tz))
+        for e in range(entries):
+            p = out.idx[e]
+            for a in range(3):
+                received[a] += out.f[e, a] * dt
+                if not implicit:
+                    f[p, a] += out.f[e, a]
+                    continue
+                fe[p, a] += out.f[e, a]
+                s_ = 0.0
+                for b in range(3):
+                    ke[p, a, b] += out.dfdx[e, a, b]
+                    de[p, a, b] += out.dfdv[e, a, b]
+                    s_ += out.dfdx[e, a, b] * out.vref[e, b]
+                kv[p, a] += s_
+        if implicit:
+            implicit_step(net, sub_load, f, dt, scheme, has_prev or step > 0)
+        else:
             symplectic_update(net.pts, f, dt)

@@ -68,13 +68,17 @@ class Figure(System, RigidParts):
     The servo gains in MuJoCo's model (actuator bias parameters) and its time step are derived
     from the controller state (omega, zeta, the support flag: all in ``capture()``) and the
     substep, rewritten from them on restore and at every advance: the model holds no state of
-    its own."""
+    its own.
+
+    feedback: None, or an object with ``offsets(figure, sensors) -> (joints,)`` rad added to
+    the targets at every control tick (a scene's own balance law: control/bounce.py) and
+    ``capture()`` / ``restore(snap)`` of its memory as plain arrays."""
 
     integrator = "MuJoCo implicitfast, PD servo actuators"
 
     def __init__(self, name: str, params: FigureParams = FigureParams(),
                  controller: Controller | None = None, fixed_base: bool = False,
-                 gravity: bool = True):
+                 gravity: bool = True, feedback=None):
         super().__init__(name, params.dt)
         import mujoco
         self._mj = mujoco
@@ -141,6 +145,13 @@ class Figure(System, RigidParts):
         self._geom_hand[self.hand_geoms] = True
         self._geom_sole = np.full(m.ngeom, -1, dtype=np.int64)
         self._geom_sole[self.sole_geoms] = (0, 1)
+        # segments another system's contact touched this step (``mark_touching``): a foot on
+        # a bed is sensed like a foot on MuJoCo's ground
+        self.touched = np.zeros(len(SEGMENTS), dtype=bool)
+        self._feet_seg = np.array([SEGMENTS.index(s) for s in FEET])
+        self._hand_seg = np.array([SEGMENTS.index(s) for s in HANDS])
+        self.feedback = feedback
+        self.offsets = np.zeros(len(jid))
         self.gravity = GravityCompensation(m, self.qadr, self.vadr, self.seg_body[feet],
                                            self.seg_geom[feet], self.free)
         self.drag = (AirDrag(m, self.seg_body, params.environment.air_density)
@@ -173,7 +184,7 @@ class Figure(System, RigidParts):
     def _reference(self, t, balance=True):
         """Desired angles (rad) and rates (rad/s) at time t (s): the state's targets, reached
         along a smoothstep 3u^2 - 2u^3 from where the previous state left them, plus the
-        balance offset on the ankles."""
+        balance offset on the ankles and the feedback's offsets."""
         target, vtarget = self.targets.copy(), self.vtargets.copy()
         if self._blend is not None:
             start, end, t0, T = self._blend
@@ -182,6 +193,8 @@ class Figure(System, RigidParts):
             vtarget += (end - start) * (6 * u - 6 * u * u) / T
         if balance and self.balance_offset:
             target[self.ankles] += self.balance_offset
+        if balance and self.feedback is not None:
+            target += self.offsets
         return target, vtarget
 
     def _feedforward(self, target) -> np.ndarray:
@@ -189,11 +202,17 @@ class Figure(System, RigidParts):
         on the feet while the state says they carry the body and one touches the ground."""
         if not self.params.gravity_compensation or (self.free and not self.support):
             return np.zeros(len(target))
-        feet = np.zeros(0, np.int64)
-        if self.free:
-            owner = self._geom_foot[self.data.contact.geom[:self.data.ncon]]
-            feet = np.flatnonzero(np.bincount(owner[owner >= 0], minlength=2))
+        feet = self.feet_touching() if self.free else np.zeros(0, np.int64)
         return self.gravity.torques(self.data.qpos, target, feet)
+
+    def feet_touching(self) -> np.ndarray:
+        """Indices (0 left, 1 right) of the feet touching anything: MuJoCo's ground under a
+        foot or its toes, or another system's contact on them this step."""
+        owner = self._geom_foot[self.data.contact.geom[:self.data.ncon]]
+        touch = np.bincount(owner[owner >= 0], minlength=2) > 0
+        ext = self.touched[self._feet_seg]
+        touch |= ext[[0, 2]] | ext[[1, 3]]  # FEET: left foot, left toes, right ...
+        return np.flatnonzero(touch)
 
     def _plan(self, t):
         """The servo reference over the control period from t (s): kp theta_d + kd thetadot_d
@@ -246,8 +265,9 @@ class Figure(System, RigidParts):
         geoms = d.contact.geom[:d.ncon]
         self._mj.mj_subtreeVel(m, d)
         com = d.subtree_com[self.root].copy()
-        return {"foot_contact": bool((self._geom_foot[geoms] >= 0).any()),
-                "hand_contact": bool(self._geom_hand[geoms].any()),
+        hands = self.touched[self._hand_seg].any()
+        return {"foot_contact": len(self.feet_touching()) > 0,
+                "hand_contact": bool(self._geom_hand[geoms].any() or hands),
                 "com": com, "com_vel": d.subtree_linvel[self.root].copy(),
                 "com_ahead": float(np.dot(com - d.geom_xpos[self.sole_geoms].mean(axis=0),
                                           self._forward())),
@@ -280,6 +300,8 @@ class Figure(System, RigidParts):
             if nxt is not None:
                 self._enter(nxt, t)
             self.balance_offset = self._balance(s) if self.fsm.state.balance else 0.0
+            if self.feedback is not None:
+                self.offsets[:] = self.feedback.offsets(self, s)
         if self._blend is not None and t >= self._blend[2] + self._blend[3]:
             self._blend = None
         self._plan(t)
@@ -296,7 +318,9 @@ class Figure(System, RigidParts):
         d = self.data
         geoms = d.contact.geom[:d.ncon]
         owner = self._geom_sole[geoms]
-        touching = self.sole_geoms[np.flatnonzero(np.bincount(owner[owner >= 0], minlength=2))]
+        sole = np.bincount(owner[owner >= 0], minlength=2) > 0
+        sole |= self.touched[self._feet_seg[[0, 2]]]
+        touching = self.sole_geoms[np.flatnonzero(sole)]
         if len(touching) == 0:
             return self.balance_offset
         centre = d.geom_xpos[touching].mean(axis=0)
@@ -311,6 +335,11 @@ class Figure(System, RigidParts):
     # --- dynamics ----------------------------------------------------------------------------
     def clear_forces(self):
         self.data.xfrc_applied[:] = 0.0
+        self.touched[:] = False
+
+    def mark_touching(self, parts):
+        """Segments another system's contact touches this step (cleared with the forces)."""
+        self.touched[np.asarray(parts, dtype=np.int64)] = True
 
     def add_wrench(self, force, torque=None, point=None, body=0):
         """Add a force (N) at a world point (m; default the segment's centre of mass) and a
@@ -437,7 +466,10 @@ class Figure(System, RigidParts):
                     support=np.array(self.support), balance=np.array(self.balance_offset),
                     blend=np.zeros(0) if self._blend is None else np.concatenate(
                         [self._blend[0], self._blend[1], self._blend[2:]]),
-                    servo=np.concatenate([self._c0, self._dc, self._ff, [self._tick]]))
+                    servo=np.concatenate([self._c0, self._dc, self._ff, [self._tick]]),
+                    touched=self.touched.copy(), offsets=self.offsets.copy())
+        if self.feedback is not None:
+            snap.update({f"feedback_{k}": v for k, v in self.feedback.capture().items()})
         return snap
 
     def restore(self, snap):
@@ -458,6 +490,10 @@ class Figure(System, RigidParts):
         n3 = 3 * n
         self._c0[:], self._dc[:], self._ff[:] = (snap["servo"][:n3].reshape(3, n))
         self._tick = float(snap["servo"][n3])
+        self.touched[:], self.offsets[:] = snap["touched"], snap["offsets"]
+        if self.feedback is not None:
+            self.feedback.restore({k[9:]: v for k, v in snap.items()
+                                   if k.startswith("feedback_")})
         self._mj.mj_forward(self.model, d)
 
     def frame(self):

@@ -20,7 +20,8 @@ from ..kernels import multigrid as MG
 from ..kernels import parallel as PAR
 from ..kernels import springs as K
 from ..kernels.contact import colliders as no_colliders
-from ..kernels.subcycle import advance_with_colliders
+from ..kernels.part_contact import Parts
+from ..kernels.subcycle import advance_with_colliders, advance_with_parts
 from .base import GRAVITY, System, substeps
 from .shape import Shape, split_color
 from .views import PointsView
@@ -39,6 +40,10 @@ class Springs:
     """A set of springs between points i and j.
 
     rest: rest length (m); stiffness: N/m; tension_only: cords that go slack when compressed.
+    A negative rest length is a preloaded extension spring (a coil spring wound with initial
+    tension, as a trampoline's): it pulls k (l - rest) at every length l, k |rest| even at
+    zero length, so it is never slack; only springs that are not tension-only may have one,
+    and the strain measure leaves them out.
     """
     i: np.ndarray
     j: np.ndarray
@@ -87,7 +92,8 @@ class SpringNetwork(System):
     triangles (m,3): its faces, when it is a surface (cloth), for contacts, aerodynamics and
     drawing; cord_radius (m): the cords' radius as drawn and as a contact skin (None: drawn
     at 8% of the median spring length); color: linear RGB (0..1) as drawn (None: the
-    outputs' default).
+    outputs' default); cords (c,2): point pairs drawn as cords beside a surface (a
+    trampoline's frame springs), a shape of their own named "<name>-cords".
     """
 
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
@@ -95,7 +101,7 @@ class SpringNetwork(System):
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
                  scheme="theta", theta=1.0, lg_iterations=10, lg_memory=3,
                  lg_tolerance=1e-4, lg_solver="auto", parallel=False, triangles=None,
-                 cord_radius=None, color=None):
+                 cord_radius=None, color=None, cords=None):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -171,6 +177,7 @@ class SpringNetwork(System):
         self.cord_radius = None if cord_radius is None else require_positive(
             name, "cord_radius", cord_radius, "m")
         self.color = color
+        self.cords = None if cords is None else np.asarray(cords, np.int64).reshape(-1, 2)
         self._pts = K.Points(self.x, self.v, self.m, self.fixed)
         self._load = K.Load(self.fext, self.kext, self.dext, self.kvref)
         self._view = None
@@ -224,9 +231,14 @@ class SpringNetwork(System):
     def _check_springs(s: Springs, n: int):
         if len(s.i) and (s.i.min() < 0 or s.j.min() < 0 or max(s.i.max(), s.j.max()) >= n):
             raise ParameterError(f"springs reference a point outside 0..{n - 1}")
-        bad = np.flatnonzero(~(s.rest > 0))
+        bad = np.flatnonzero(~((s.rest > 0) | ((s.rest < 0) & ~s.tension_only)))
         if len(bad):
-            raise ParameterError(f"spring {bad[0]} ({s.i[bad[0]]}-{s.j[bad[0]]}) has zero rest "
+            b = bad[0]
+            if s.rest[b] < 0:
+                raise ParameterError(f"spring {b} ({s.i[b]}-{s.j[b]}) is a tension-only cord "
+                                     f"with negative rest length {s.rest[b]} m; only preloaded "
+                                     "springs (never slack) may have one")
+            raise ParameterError(f"spring {b} ({s.i[b]}-{s.j[b]}) has zero rest "
                                  "length: remove the duplicate point or edge")
         bad = np.flatnonzero(~(s.stiffness > 0))
         if len(bad):
@@ -293,10 +305,21 @@ class SpringNetwork(System):
         ``advance`` (local/global: after every step, points only). One batch per advance; a
         second with the same elements is merged."""
         elems = np.ascontiguousarray(elements, dtype=np.int64)
+        if isinstance(colliders, Parts):  # rigid parts: one batch, explicit or implicit
+            if self.integrator == "localglobal":
+                return False
+            if self._cols is not None:
+                raise SceneError(f"{self.name}: a second sub-cycled contact in one coupling "
+                                 "step with rigid parts; exchange one of them in lock step")
+            self._cols = (colliders, elems, [colliders])
+            return True
         if self._cols is None:
             self._cols = (colliders, elems, [colliders])
             return True
         cols, old, parts = self._cols
+        if isinstance(cols, Parts):
+            raise SceneError(f"{self.name}: a sub-cycled contact with rigid parts already "
+                             "acts in this coupling step; exchange one of them in lock step")
         if old.shape != elems.shape or not np.array_equal(old, elems):
             raise SceneError(f"{self.name}: two sub-cycled contacts with different elements in "
                              "one coupling step; give them the same elements or exchange one "
@@ -339,19 +362,28 @@ class SpringNetwork(System):
         anchors = self.a_pos.copy() if len(self.a_pos) else None
         color, per_point = split_color(self.color)
         if self.triangles is not None:
-            return [Shape(self.name, "surface", color=color, triangles=self.triangles,
-                          anchors=anchors, palette="cloth", point_colors=per_point,
-                          material="cloth", double_sided=True)]
+            out = [Shape(self.name, "surface", color=color, triangles=self.triangles,
+                         anchors=anchors, palette="cloth", point_colors=per_point,
+                         material="cloth", double_sided=True)]
+            if self.cords is not None:
+                # the springs a surface hangs from (a trampoline's frame springs): steel coils
+                out.append(Shape(f"{self.name}-cords", "cords", segments=self.cords,
+                                 width=self._cord_width(self.cords), palette="static",
+                                 source=(self.name, "points"), material="metal"))
+            return out
         seg = self.segments()
+        return [Shape(self.name, "cords", color=color, segments=seg,
+                      width=self._cord_width(seg), anchors=anchors, palette="cloth",
+                      material="cloth")]
+
+    def _cord_width(self, seg) -> float:
+        """A drawn cord's diameter (m): twice cord_radius, else 8% of the median length."""
         if self.cord_radius is not None:
-            width = 2.0 * self.cord_radius
-        elif len(seg):
+            return 2.0 * self.cord_radius
+        if len(seg):
             lengths = np.linalg.norm(self.x[seg[:, 0]] - self.x[seg[:, 1]], axis=1)
-            width = float(np.clip(0.08 * np.median(lengths), 0.002, 0.02))
-        else:
-            width = 0.005
-        return [Shape(self.name, "cords", color=color, segments=seg, width=width,
-                      anchors=anchors, palette="cloth", material="cloth")]
+            return float(np.clip(0.08 * np.median(lengths), 0.002, 0.02))
+        return 0.005
 
     def _factors(self, h):
         """The local/global preconditioner for step h (kernels.localglobal.Factors) and the
@@ -418,8 +450,12 @@ class SpringNetwork(System):
             self._localglobal(h, n)
         elif self._cols is not None:
             cols, elems, _ = self._cols
-            advance_with_colliders(self.bundle(), self._load, self._f, h, n, self._scheme(),
-                                   self.has_prev, cols, elems)
+            if isinstance(cols, Parts):
+                advance_with_parts(self.bundle(), self._load, self._f, h, n, self._scheme(),
+                                   self.has_prev, cols)
+            else:
+                advance_with_colliders(self.bundle(), self._load, self._f, h, n,
+                                       self._scheme(), self.has_prev, cols, elems)
             self.has_prev = self.scheme == "bdf2" and self.integrator == "implicit"
         elif self.integrator == "explicit" and n > 1:
             self._explicit(h / n, n)

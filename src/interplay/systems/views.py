@@ -129,6 +129,10 @@ class RigidParts(ABC):
         cannot be pushed ignore it. A system that can carry points tied to it (a free rigid
         body) also takes ``carried`` (see BodiesView.apply)."""
 
+    def mark_touching(self, parts):
+        """Parts (indices) a contact touched this step, for the system's own sensors (a
+        figure's foot-contact events); ignored by systems without sensors."""
+
 
 class BodiesView(_View):
     """Rigid parts. ``names`` (k,); ``meshes`` [(vertices (v,3), triangles (t,3))] in each
@@ -197,6 +201,12 @@ class BodiesView(_View):
             self.system.add_part_wrench(part, force, torque, point, dfdx, dfdv)
         else:
             self.system.add_part_wrench(part, force, torque, point, dfdx, dfdv, carried=carried)
+
+    def touched(self, parts) -> None:
+        """Tell the system that a contact touches these parts (indices) this step: sensing,
+        not force (a figure's state machine reads foot contact from it)."""
+        if self.movable:
+            self.system.mark_touching(parts)
 
 
 class ShapeView(_View):

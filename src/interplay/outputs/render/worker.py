@@ -21,8 +21,13 @@ _WORKER = None
 
 
 def _serve(conn):
+    import signal
     from . import gl
     from .video import _ffmpeg
+    # the parent's SIGTERM handler (cli/command.py) raises in the parent; the parent ends
+    # this daemon with SIGTERM when it exits, which here must just end it, without a traceback
+    # under the parent's one-line error
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     try:
         gl._CTX = None  # never the parent's: it had none when this process was forked
         gl.gl_context()

@@ -1,0 +1,260 @@
+"""The bounce controller: a gymnast's straight bounce on a trampoline, as a state machine in
+the style of the paper's (SPEC 2.3), with a balance law that keeps her over the bed's centre.
+
+States, each a set of joint targets (control/fsm.py):
+
+* ``flight``: straight body, toes pointed, arms overhead; at the apex (centre of mass
+  falling) she hands over to
+* ``descend``: the legs prepare for landing (knees and hips flexed to ``knee_land`` and
+  ``hip_land``, feet flat, stiff stance gains ``leg_omega``), arms come down in front; on
+  foot contact
+* ``absorb``: the legs hold their flexion against the bed while it is depressed, for
+  ``thrust_delay`` s, then
+* ``thrust``: hips, knees and ankles extend (velocity targets scaled by ``power``, the
+  ankles to ``ankle_push``) timed to the bed's recoil, and the arms swing up to
+  ``arm_swing``; when both feet leave the bed she is in ``flight`` again.
+
+Balance (``BounceBalance``, the figure's feedback at every control tick), after Raibert's
+hopping machines: in the air the legs are placed for the landing, hip flexion (forward-back)
+and abduction (sideways) turned so the feet land ahead of the centre of mass by
+``k_speed`` v + ``k_place`` (c - c0) along each axis (v the centre of mass's horizontal
+velocity, c - c0 its offset from the bed's centre), which brakes a drift and steers her back;
+on the bed the hips servo the pelvis upright against the planted legs (``k_attitude`` of the
+legs' lean), which stops the body rotating. Offsets slew at most SLEW so a new phase does not
+kick the servos.
+
+Angles in rad (anatomical sense: flexion positive; ankle flexion is dorsiflexion), times in
+s, gains as stated. The defaults of ``BounceParams`` are the output of ``interplay tune
+trampoline`` (control/search.py simulated annealing; docs/trampoline.md).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..geometry.anthropometry import SEGMENTS
+from ..params import param
+from .fsm import Controller, State, Transition
+
+SLEW = 4.0  # rad/s: the balance offsets' fastest change
+PLACE_MAX = 0.35  # rad: the largest leg angle the foot placement asks for
+LEG_LENGTH = 0.85  # m: hip to sole of the default 1.70 m gymnast, for the placement angle
+ARM_RANGE = (-1.0, 2.5)  # rad: how far the circling arms may go from their pose
+EXTEND = 8.0  # 1/s: the thrust's extension rate, as a share of the crouch per second, at power 1
+
+
+@dataclass(frozen=True)
+class BounceParams:
+    """The bounce controller's free parameters (the search's variables; units in the module
+    docstring): landing posture knee_land (rad; the ankles and hips bend by half of it so the
+    hips stay over the ankles), lean (rad of extra ankle flexion: the body forward over the
+    middle of the feet) and trunk (rad of extra hip flexion);
+    leg_omega (rad/s): the stance legs' servo frequency, ankle_share (-) the ankles' share
+    of it on the bed; thrust_delay (s) after touchdown;
+    power (-): the extension's velocity targets; ankle_push (rad, negative: plantarflexion);
+    arm_swing (rad of shoulder abduction at takeoff: the arms rise sideways, so the two
+    arms' angular momenta cancel and the swing does not tip her), arm_land (rad); foot
+    placement k_speed (s), k_place (-); on the bed, the ankles' feedback on the centre of
+    mass's lead over the feet k_lead (rad/m), on its velocity k_drift (rad s/m) and on the
+    body's angular momentum k_spin (rad per kg m^2/s), and the hips' servo of the pelvis
+    upright against the legs' lean, k_attitude (-); in the air, k_turn (m per kg m^2/s):
+    the feet land that much behind the centre of mass per unit of the body's backward
+    angular momentum, so the bed's push on the next landing turns the spin back; on the bed,
+    k_hip_spin (rad per kg m^2/s): the hips extend against a backward spin (and flex against
+    a forward one), which turns the legs' push on the bed, and with it the bed's friction
+    under the feet a metre below the centre of mass, against the spin; k_arms (-): the share
+    of the body's pitch spin the arms take in the air by circling (forward against a
+    backward spin), so the trunk lands upright, a trampolinist's correction."""
+    knee_land: float = param(
+        0.14445817435485553, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
+    lean: float = param(-0.0488264489650417, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
+    trunk: float = param(-0.03840802227306958, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
+    leg_omega: float = param(
+        12.8848547499585, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
+    ankle_share: float = param(
+        0.7741162175548496, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
+    thrust_delay: float = param(0.16237907246390273, "s", ge=0.0, le=2.0, doc="after touchdown")
+    power: float = param(0.5841121639613117, "-", gt=0.0, le=5.0, doc="the extension's speed")
+    ankle_push: float = param(0.35920869840470787, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
+    arm_swing: float = param(3.1, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
+    arm_land: float = param(
+        0.003616482133918858, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
+    k_speed: float = param(0.6, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+    k_place: float = param(
+        0.46001672902920826, "-", ge=0.0, le=5.0, doc="foot placement on offset")
+    k_lead: float = param(4.970550615473857, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.08162544824107555, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.0164970699297445, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.04171894873496466, "-", ge=0.0, le=3.0)
+    k_turn: float = param(0.003324037518460548, "m s/(kg m^2)", ge=-1.0, le=1.0)
+    k_hip_spin: float = param(-0.06, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    k_arms: float = param(0.05108273094290473, "-", ge=0.0, le=5.0)
+
+    def validated(self) -> "BounceParams":
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise ParameterError(f"bounce controller: {f.name} must be a finite number, "
+                                     f"got {v!r}")
+        if not (self.leg_omega > 0 and self.thrust_delay >= 0 and self.power > 0):
+            raise ParameterError("bounce controller: leg_omega and power must be positive and "
+                                 f"thrust_delay >= 0 s, got {self.leg_omega}, {self.power}, "
+                                 f"{self.thrust_delay}")
+        return self
+
+
+#: the search's box: name -> (low, high), in the units above
+BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4),
+          "leg_omega": (6.0, 20.0), "ankle_share": (0.05, 1.0), "thrust_delay": (0.0, 0.3),
+          "power": (0.3, 2.0), "ankle_push": (-0.6, 0.4), "arm_swing": (1.5, 3.1),
+          "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6), "k_place": (0.0, 1.0),
+          "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5), "k_spin": (0.0, 0.05),
+          "k_attitude": (0.0, 1.2), "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
+          "k_arms": (0.0, 1.5)}
+
+
+def controller(p: BounceParams) -> Controller:
+    """flight -> descend -> absorb -> thrust -> flight, starting in descend (she is dropped
+    from her first apex)."""
+    p = p.validated()
+    legs = (("hip", p.leg_omega), ("knee", p.leg_omega), ("ankle", p.leg_omega))
+    # on the bed the ankles may be softer: a limp ankle puts no torque into the bed, so the
+    # bed's push runs from the foot up the leg, nearer the centre of mass
+    stance = (("hip", p.leg_omega), ("knee", p.leg_omega),
+              ("ankle", p.ankle_share * p.leg_omega))
+    flight = State("flight", pose=(("hip", 0.0), ("knee", 0.05), ("ankle", -0.3), ("waist", 0.0),
+                                   ("neck", 0.0), ("shoulder_flex", 0.0),
+                                   ("shoulder_abd", p.arm_swing), ("elbow", 0.05),
+                                   ("toe", 0.0)),
+                   transitions=(Transition("com_falling", "descend"),), blend=0.15)
+    descend = State("descend", pose=(("hip_flex", 0.5 * p.knee_land + p.trunk),
+                                     ("hip_abd", 0.0), ("knee", p.knee_land),
+                                     ("ankle", 0.5 * p.knee_land + p.lean),
+                                     ("shoulder_abd", p.arm_land), ("elbow", 0.1)),
+                    gains=legs, support=True, blend=0.4,
+                    transitions=(Transition("foot_contact", "absorb"),))
+    absorb = State("absorb", gains=stance, support=True, blend=0.0,
+                   transitions=(Transition("time", "thrust", p.thrust_delay),
+                                Transition("no_foot_contact", "flight")))
+    # the extension keeps the trunk's tilt in the world (trunk + lean, forward): the hips open
+    # by exactly what the thighs turn, so no part of the body is swung round against the bed
+    # and the push adds no spin; velocities in proportion, so the hips rise over the feet
+    hip_end = p.trunk + p.lean - p.ankle_push
+    thrust = State("thrust", pose=(("hip_flex", hip_end), ("knee", 0.0), ("ankle", p.ankle_push),
+                                   ("shoulder_abd", p.arm_swing), ("elbow", 0.0)),
+                   velocity=(("hip_flex", -EXTEND * p.power * (0.5 * p.knee_land + p.trunk
+                                                              - hip_end)),
+                             ("knee", -EXTEND * p.power * p.knee_land),
+                             ("ankle", -EXTEND * p.power * (0.5 * p.knee_land + p.lean
+                                                            - p.ankle_push)),
+                             ("shoulder_abd", 8.0)),
+                   gains=stance, support=True, blend=0.0,
+                   transitions=(Transition("no_foot_contact", "flight"),))
+    return Controller((flight, descend, absorb, thrust), start="descend")
+
+
+class BounceBalance:
+    """The figure's feedback (systems/figure.py): joint offsets (rad), foot placement in the
+    air and the ankles' balance on the bed; centre (m): the bed's centre (x, y)."""
+
+    def __init__(self, p: BounceParams, joints, centre=(0.0, 0.0)):
+        self.p = p.validated()
+        self.centre = np.asarray(centre, float)
+        idx = {n: i for i, n in enumerate(joints)}
+        self.flex = np.array([idx["l_hip_flex"], idx["r_hip_flex"]])
+        self.ankles = np.array([idx["l_ankle"], idx["r_ankle"]])
+        self.thighs = [SEGMENTS.index("l_thigh"), SEGMENTS.index("r_thigh")]
+        self.shoulders = np.array([idx["l_shoulder_flex"], idx["r_shoulder_flex"]])
+        self.arms = None  # kg m^2: the arms' inertia about the shoulders' axis (first tick)
+        self.abd_l, self.abd_r = idx["l_hip_abd"], idx["r_hip_abd"]
+        self.out = np.zeros(len(joints))
+
+    def capture(self) -> dict:
+        # the arms' inertia is measured at the first tick's pose: a resumed run keeps it
+        return {"out": self.out.copy(),
+                "arms": np.array([np.nan if self.arms is None else self.arms])}
+
+    def restore(self, snap: dict):
+        if snap:
+            self.out[:] = snap["out"]
+            arms = float(np.asarray(snap["arms"]).ravel()[0])
+            self.arms = None if math.isnan(arms) else arms
+
+    def offsets(self, fig, sensors) -> np.ndarray:
+        d = fig.data
+        R = d.xmat[fig.root].reshape(3, 3)
+        fwd = R[:, 0].copy()
+        fwd[2] = 0.0
+        fwd /= max(np.linalg.norm(fwd), 1e-9)
+        left = np.array([-fwd[1], fwd[0], 0.0])
+        p = self.p
+        com, v = sensors["com"], sensors["com_vel"]
+        want = np.zeros_like(self.out)
+        if len(fig.feet_touching()):
+            # on the bed: the ankle strategy, steering the pressure under the feet to keep the
+            # centre of mass over them and the body from rotating
+            lead = (com - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ fwd
+            spin = d.subtree_angmom[fig.root] @ left  # > 0: pitching forward
+            want[self.ankles] = -(p.k_lead * lead + p.k_drift * (v @ fwd) + p.k_spin * spin)
+            # and the hips: flexed by the legs' lean, the pelvis is held upright over them
+            leg = (d.geom_xpos[fig.sole_geoms].mean(axis=0)
+                   - d.xpos[fig.seg_body[self.thighs]].mean(axis=0))
+            want[self.flex] = (p.k_attitude * math.atan2(leg @ fwd, -leg[2])
+                               + p.k_hip_spin * spin)
+            side = (p.k_attitude * math.atan2(leg @ left, -leg[2])
+                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd))
+            want[self.abd_l], want[self.abd_r] = side, -side
+        else:
+            # in the air: place the feet ahead of the centre of mass to brake and steer back,
+            # the hips turned against the pelvis's pitch and roll so the legs aim in the world
+            up = R[:, 2]
+            pitch = math.atan2(up @ fwd, up[2])  # pelvis leaning forward: > 0
+            roll = math.atan2(-(up @ left), up[2])  # leaning to her right: > 0
+            c = com[:2] - self.centre
+            spin = d.subtree_angmom[fig.root]  # kg m^2/s: forward pitch about +left
+            turn_fwd = p.k_turn * (spin @ left)  # spinning forward: land with the feet ahead
+            turn_side = -p.k_turn * (spin @ fwd)  # rolling to her right: feet to the right
+
+            def angle(a):
+                return float(np.clip(math.asin(np.clip(a / LEG_LENGTH, -1.0, 1.0)),
+                                     -PLACE_MAX, PLACE_MAX))
+            tilt = PLACE_MAX
+            along = angle(p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2])
+                          + turn_fwd)
+            side = angle(p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2])
+                         + turn_side)
+            want[self.flex] = along + float(np.clip(pitch, -tilt, tilt))
+            want[self.abd_l] = side - float(np.clip(roll, -tilt, tilt))
+            want[self.abd_r] = -want[self.abd_l]
+        step = SLEW * fig.control_dt
+        self.out[:] = np.clip(want, self.out - step, self.out + step)
+        # the arms circle in the air against the body's pitch spin (the offset integrates the
+        # rate r = -k L / I_arms: shoulder flexion turns the arms about -left), and come back
+        # on the bed
+        if self.arms is None:
+            self.arms = arm_inertia(fig)
+        if len(fig.feet_touching()):
+            self.out[self.shoulders] = self.out[self.shoulders] - np.clip(
+                self.out[self.shoulders], -step, step)
+        else:
+            rate = -p.k_arms * (d.subtree_angmom[fig.root] @ left) / self.arms
+            self.out[self.shoulders] = np.clip(self.out[self.shoulders]
+                                               + rate * fig.control_dt, *ARM_RANGE)
+        return self.out
+
+
+def arm_inertia(fig) -> float:
+    """(kg m^2) both arms' moment of inertia about the line through the shoulders, at rest
+    hanging: sum m_i (d_i^2) + I_i over the upper arms, forearms and hands."""
+    m, d = fig.model, fig.data
+    total = 0.0
+    for side in ("l", "r"):
+        shoulder = d.xpos[fig.seg_body[SEGMENTS.index(f"{side}_upper_arm")]]
+        for seg in ("upper_arm", "forearm", "hand"):
+            b = fig.seg_body[SEGMENTS.index(f"{side}_{seg}")]
+            r = d.xipos[b] - shoulder
+            total += m.body_mass[b] * (r[0] ** 2 + r[2] ** 2) + m.body_inertia[b][1]
+    return float(total)

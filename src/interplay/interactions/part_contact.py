@@ -1,0 +1,216 @@
+"""Contact of rigid parts with a spring-mass network, sub-cycled in the network's substeps
+(SPEC 2.5): a figure's 17 segments on a trampoline bed, a ball on a net of cords.
+
+It reads only the two contact views: the parts' analytic primitives (spheres, capsules,
+boxes: ``BodiesView.primitives``), poses, centres of mass, velocities and masses; the
+network's points and its elements (the edges of its triangles, else its springs). At every
+coupling step it finds, per part, the elements it may reach within the step
+(kernels/part_contact.candidates) and, when any, hands the network the parts on their
+predicted paths through the sub-cycling hook (``PointsView.subcycle``): the network collides
+them with those elements at every one of its substeps through the one contact law, and each
+part then receives the impulse it got, as the step's mean force and torque about its centre of
+mass. A bed point of a few grams under a gymnast's foot is thrown across its contact skin
+within a fraction of a millisecond; exchanged once per 1 ms coupling step the contact could
+not be both stiff and stable, sub-cycled it is. A network that cannot sub-cycle (local/global)
+gets the same law once per coupling step.
+
+Stiffness and damping default to the pair's effective mass and the network's substep:
+c_s = m_eff (1/(n dt))^2, c_d = 2 m_eff/(n dt), n = ``contact_steps`` (critically damped, no
+bounce); the constraint term carries a resting load without sinking. Friction is the law's
+regularised Coulomb, capped at the force that stops the slip within a substep, so a planted
+foot drags the bed's points with it instead of skating over them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, SceneError, require_nonnegative, require_positive
+from ..kernels import part_contact as PC
+from ..kernels.springs import point_forces
+from ..params import param
+from .base import Interaction
+
+
+@dataclass(frozen=True)
+class PartContactParams:
+    """thickness (m): the network's contact skin (half a bed's thickness); friction mu (-);
+    eps (m/s): slip speed of full Coulomb friction; stiffness (N/m), damping (N s/m): None
+    chooses them per contact from the effective mass and the substep; contact_steps: the
+    substeps over which a penetration is resolved (with the default stiffness); constraint:
+    include the constraint term; margin (m): how much farther than a part can reach in a step
+    its candidate elements are gathered."""
+    thickness: float = param(0.004, "m", ge=0.0, le=0.2)
+    friction: float = param(0.8, "-", ge=0.0, le=10.0)
+    eps: float = param(0.01, "m/s", gt=0.0, le=10.0)
+    stiffness: float | None = param(None, "N/m", gt=0.0, le=1e9, doc="None: per contact")
+    damping: float | None = param(None, "N s/m", ge=0.0, le=1e7, doc="None: per contact")
+    contact_steps: float = param(3.0, "substeps", ge=1.0, le=1000.0)
+    constraint: bool = param(True, doc="include the constraint term")
+    margin: float = param(0.01, "m", ge=0.0, le=1.0)
+
+    def validated(self, owner: str) -> "PartContactParams":
+        require_nonnegative(owner, "contact thickness", self.thickness, "m")
+        require_nonnegative(owner, "friction", self.friction)
+        require_positive(owner, "friction eps", self.eps, "m/s")
+        if self.stiffness is not None:
+            require_positive(owner, "contact stiffness", self.stiffness, "N/m")
+        if self.damping is not None:
+            require_nonnegative(owner, "contact damping", self.damping, "N s/m")
+        require_positive(owner, "contact_steps", self.contact_steps)
+        require_nonnegative(owner, "candidate margin", self.margin, "m")
+        return self
+
+    def law(self) -> np.ndarray:
+        """The law's row (kernels/contact.py); stiffness and damping -1: from the mass."""
+        return np.array([self.thickness, -1.0 if self.stiffness is None else self.stiffness,
+                         -1.0 if self.damping is None else self.damping, self.friction,
+                         self.eps, 1.0 if self.constraint else 0.0])
+
+
+def _edges(triangles) -> np.ndarray:
+    """Unique edges (e,2) of a triangle set."""
+    t = np.asarray(triangles, np.int64)
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    return np.unique(e, axis=0)
+
+
+class PartContact(Interaction):
+    """Rigid parts (primary: any system seen as BodiesView with primitives) against a spring
+    network's elements (secondary: a PointsView). elements (s,2): point pairs to collide
+    ((p, p) for points); default the edges of its triangles, else its springs."""
+
+    def __init__(self, name, bodies, network, params: PartContactParams = PartContactParams(),
+                 mode="two-way", standin=None, elements=None):
+        super().__init__(name, bodies, network, mode, standin)
+        self.p = params.validated(name)
+        view, net = bodies.contact_view(), network.contact_view()
+        if view is None or view.kind != "bodies":
+            raise SceneError(f"interaction {name}: {bodies.name} is not seen as rigid parts; "
+                             "this contact needs a body or a figure")
+        if net is None or net.kind != "points":
+            raise SceneError(f"interaction {name}: {network.name} is not a spring-mass "
+                             "network; use MeshContact for other surfaces")
+        missing = [nm for nm, pr in zip(view.names, view.primitives) if pr is None
+                   or pr.kind not in PC.KINDS]
+        if missing:
+            raise SceneError(f"interaction {name}: parts {', '.join(missing)} of "
+                             f"{bodies.name} have no sphere, capsule or box primitive; use "
+                             "MeshContact")
+        self.view, self.net = view, net
+        if elements is None:
+            elements = _edges(net.triangles) if net.triangles is not None else net.segments
+        elems = np.ascontiguousarray(elements, dtype=np.int64).reshape(-1, 2)
+        if len(elems) and (elems.min() < 0 or elems.max() >= len(net.x)):
+            raise ParameterError(f"interaction {name}: elements reference points outside "
+                                 f"0..{len(net.x) - 1} of {network.name}")
+        self.parts = self._parts(elems)
+        self._out = point_forces(2 * self.view.count * len(elems))
+        self._touches = PC.touches(self.view.count * len(elems), self.view.count, len(net.x))
+        self._wrenches = np.zeros((self.view.count, 6))
+        self._h = 0.0
+        self.n_contacts = 0
+
+    def _parts(self, elems) -> PC.Parts:
+        """The kernels' bundle: each primitive relative to its part's centre of mass (fixed in
+        the part's frame, so computed once from the current pose)."""
+        v = self.view
+        k = v.count
+        origin, R = v.poses()
+        com = v.centres()
+        kind, p, q, size, reach = (np.zeros(k, np.int64), np.zeros((k, 3)), np.zeros((k, 3)),
+                                   np.zeros((k, 3)), np.zeros(k))
+        for j, pr in enumerate(v.primitives):
+            off = R[j].T @ (com[j] - origin[j])  # the centre of mass in the part's frame
+            kind[j] = PC.KINDS[pr.kind]
+            if pr.kind == "capsule":
+                p[j], q[j] = np.asarray(pr.a) - off, np.asarray(pr.b) - off
+                size[j, 0] = pr.radius
+                reach[j] = max(np.linalg.norm(p[j]), np.linalg.norm(q[j])) + pr.radius
+            elif pr.kind == "box":
+                p[j], size[j] = np.asarray(pr.centre) - off, pr.axes
+                reach[j] = np.linalg.norm(p[j]) + np.linalg.norm(size[j])
+            else:
+                p[j], size[j, 0] = np.asarray(pr.centre) - off, pr.radius
+                reach[j] = np.linalg.norm(p[j]) + pr.radius
+        law = np.tile(self.p.law(), (k, 1))
+        return PC.Parts(kind, p, q, size, reach, np.zeros((k, 3)), np.zeros((k, 3, 3)),
+                        np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
+                        np.asarray(v.masses, float).copy(), law, float(self.p.contact_steps),
+                        elems, np.zeros(k + 1, np.int64), np.zeros(k * len(elems), np.int64),
+                        np.zeros((k, 7)), np.zeros(1), np.zeros(3))
+
+    def prepare(self, h, dts=None):
+        self._h = h
+
+    def capture(self) -> dict:
+        """The stand-in's memory (the rigid-parts contact itself keeps none between steps)."""
+        cap = getattr(self.standin, "capture", None)
+        return {f"standin_{k}": v for k, v in cap().items()} if cap else {}
+
+    def restore(self, snap: dict):
+        if self.standin is not None and hasattr(self.standin, "restore"):
+            self.standin.restore({k[8:]: v for k, v in snap.items() if k.startswith("standin_")})
+
+    def _motion(self):
+        """Copy the parts' state now into the bundle."""
+        P, v = self.parts, self.view
+        _, R = v.poses()
+        P.rotations[:] = R
+        P.centres[:] = v.centres()
+        lin, ang = v.velocities()
+        P.velocities[:], P.spins[:] = lin, ang
+        P.accels[:] = v.free_accelerations()
+
+    def exchange(self, to_primary, to_secondary):
+        self._motion()
+        net = self.net
+        if PC.candidates(self.parts, net.x, net.v, self._h, self.p.margin) == 0:
+            self.n_contacts = 0
+            self.parts.impulses[:] = 0.0
+            self.parts.received[:] = 0.0
+            return np.zeros(3), np.zeros(3), False
+        if to_secondary and net.subcycle(self.parts, self.parts.elems):
+            return None
+        return self._lock_step(to_primary, to_secondary)
+
+    def _lock_step(self, to_primary, to_secondary):
+        """The law once per coupling step (a network that cannot sub-cycle): forces from the
+        states now, held over the step."""
+        P, net = self.parts, self.net
+        acc = net.accelerations() if self.p.constraint else np.zeros_like(net.x)
+        cnt = PC.find_touches(P, 0.0, net.x, self._touches)
+        k = PC.touch_forces(P, self._touches, cnt, net.points, acc, self._h, self._out,
+                            net.jacobians, self._wrenches)
+        P.impulses[:, :6] = self._wrenches * self._h
+        P.impulses[:, 6] = np.linalg.norm(self._wrenches[:, :3], axis=1)
+        P.peak[0] = np.linalg.norm(self._wrenches[:, :3].sum(axis=0))
+        P.received[:] = self._out.f[:k].sum(axis=0) * self._h
+        if to_secondary and k:
+            o = self._out
+            net.apply(o.idx[:k], o.f[:k], o.dfdx[:k], o.dfdv[:k], o.vref[:k])
+        return self.complete(to_primary)
+
+    def complete(self, to_primary):
+        """The step's mean force and torque on each part (impulse / h), applied at its centre
+        of mass; returns their sum and torque about the system's centre of mass."""
+        P, h = self.parts, self._h
+        touched = np.flatnonzero(P.impulses[:, 6] > 0.0)
+        self.n_contacts = len(touched)
+        f = P.impulses[touched, :3] / h
+        tau = P.impulses[touched, 3:6] / h
+        if to_primary:
+            for j, fj, tj in zip(touched, f, tau):
+                self.view.apply(int(j), fj, tj)
+            self.view.touched(touched)
+        total = f.sum(axis=0)
+        if not len(touched):
+            return np.zeros(3), np.zeros(3), False
+        arm = P.centres[touched] - self.view.centre_of_mass()
+        torque = (tau + np.cross(arm, f)).sum(axis=0)
+        return total, torque, True, float(P.peak[0])
+
+    def segment_forces(self) -> np.ndarray:
+        """(k,3) the last step's mean force (N) on each part."""
+        return self.parts.impulses[:, :3] / self._h

@@ -1,0 +1,468 @@
+"""Rigid parts (spheres, capsules, boxes: a ball, a figure's segments) against a spring-mass
+network's segments or points, through the one contact law (SPEC 2.5).
+
+The parts move along predicted paths through a coupling step of h: centre of mass
+c0 + v t + a t^2 / 2 and rotation exp([w t]) R0, their own forces changing those paths by far
+less than the network's points move (a gymnast's foot under 8 body weights gains 0.08 m/s in
+1 ms; a bed point of 27 g is thrown across its contact skin in a fraction of that). So a light,
+stiff network can integrate the contact inside its own substeps (kernels/subcycle.py), while
+each part receives the step's impulse: equal and opposite to what the points received, and
+momentum is conserved exactly.
+
+Geometry per (part, element): a sphere or capsule against a segment by closest points
+(Ericson 5.1.9); a box against a segment by minimising the box's signed distance along the
+segment (convex in the segment's parameter, so golden-section search finds the deepest point).
+A network's element is a segment (a spring, a triangle edge) or a point given as (p, p).
+Units SI; normals point from the element towards the part.
+"""
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS
+from .contact_law import friction_damping, normal_force, sliding_friction
+
+SPHERE, CAPSULE, BOX = 0, 1, 2
+KINDS = {"sphere": SPHERE, "capsule": CAPSULE, "box": BOX}
+GOLDEN_ITERATIONS = 14  # shrinks the bracket to 0.618^14 ~ 1e-3 of the segment's length
+
+
+class Parts(NamedTuple):
+    """k rigid parts and the network elements they may touch in one coupling step.
+
+    Primitive in each part's frame, relative to its centre of mass: kind (k,) SPHERE, CAPSULE
+    or BOX; p (k,3) a sphere's or box's centre or a capsule's first end (m); q (k,3) a
+    capsule's second end (m); size (k,3) the radius in [0] (sphere, capsule) or a box's half
+    extents (m); reach (k,) m the primitive's farthest point from the centre of mass.
+    Motion at the step's start: centres (k,3) m, rotations (k,3,3) part to world, velocities
+    (k,3) m/s, spins (k,3) rad/s, accels (k,3) m/s^2; masses (k,) kg; law (k,6) each part's
+    contact law (kernels/contact.py; STIFFNESS, DAMPING < 0: from the pair's mass, resolving
+    a penetration over ``steps`` substeps, critically damped). elems (s,2) the network's
+    elements; start (k+1,), cand (c,) candidate elements of each part (``candidates``).
+    Out: impulses (k,7) impulse (N s), angular impulse about the centre of mass (N m s) and
+    peak force (N) per part over the step; peak (1,) the largest total force (N) of any
+    substep; received (3,) the impulse (N s) the network's points received (minus the parts'
+    sum: the exchange is equal and opposite)."""
+    kind: np.ndarray
+    p: np.ndarray
+    q: np.ndarray
+    size: np.ndarray
+    reach: np.ndarray
+    centres: np.ndarray
+    rotations: np.ndarray
+    velocities: np.ndarray
+    spins: np.ndarray
+    accels: np.ndarray
+    masses: np.ndarray
+    law: np.ndarray
+    steps: float
+    elems: np.ndarray
+    start: np.ndarray
+    cand: np.ndarray
+    impulses: np.ndarray
+    peak: np.ndarray
+    received: np.ndarray
+
+
+@njit(cache=True)
+def _primitive_box(parts, j, c, R, lo, hi):
+    """The world box (lo, hi) of part j's primitive with its centre of mass at c, rotation R."""
+    kind, p, q, size = parts.kind[j], parts.p[j], parts.q[j], parts.size[j]
+    for r in range(3):
+        a = c[r] + R[r, 0] * p[0] + R[r, 1] * p[1] + R[r, 2] * p[2]
+        if kind == BOX:
+            ext = abs(R[r, 0]) * size[0] + abs(R[r, 1]) * size[1] + abs(R[r, 2]) * size[2]
+            lo[r], hi[r] = a - ext, a + ext
+        elif kind == CAPSULE:
+            b = c[r] + R[r, 0] * q[0] + R[r, 1] * q[1] + R[r, 2] * q[2]
+            lo[r], hi[r] = min(a, b) - size[0], max(a, b) + size[0]
+        else:
+            lo[r], hi[r] = a - size[0], a + size[0]
+
+
+@njit(cache=True)
+def candidates(parts, x, v, h, margin):
+    """Fill parts.start / parts.cand with, per part, the elements whose bounding box meets the
+    box its primitive sweeps over h (s): its boxes at the step's start and end (the spin's
+    turn bounded by |w| h reach), grown by the contact skin, by how far the network's points
+    move in h at their fastest and by ``margin`` (m). Returns the total count; parts away from
+    the network's box are skipped whole, so flight costs a box test per part."""
+    elems, start, cand = parts.elems, parts.start, parts.cand
+    n = x.shape[0]
+    nlo = np.empty(3)
+    nhi = np.empty(3)
+    vmax = 0.0
+    for r in range(3):
+        nlo[r] = x[0, r]
+        nhi[r] = x[0, r]
+    for i in range(n):
+        s2 = 0.0
+        for r in range(3):
+            nlo[r] = min(nlo[r], x[i, r])
+            nhi[r] = max(nhi[r], x[i, r])
+            s2 += v[i, r] * v[i, r]
+        vmax = max(vmax, s2)
+    grow = np.sqrt(vmax) * h + margin
+    lo, hi, lo1, hi1 = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    c1 = np.empty(3)
+    k = 0
+    for j in range(parts.kind.shape[0]):
+        start[j] = k
+        R = parts.rotations[j]
+        _primitive_box(parts, j, parts.centres[j], R, lo, hi)
+        w = parts.spins[j]
+        turn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * h * parts.reach[j]
+        for r in range(3):
+            c1[r] = (parts.centres[j, r] + parts.velocities[j, r] * h
+                     + 0.5 * parts.accels[j, r] * h * h)
+        _primitive_box(parts, j, c1, R, lo1, hi1)
+        pad = parts.law[j, THICKNESS] + grow + turn
+        far = False
+        for r in range(3):
+            lo[r] = min(lo[r], lo1[r]) - pad
+            hi[r] = max(hi[r], hi1[r]) + pad
+            if hi[r] < nlo[r] or lo[r] > nhi[r]:
+                far = True
+        if far:
+            continue
+        for e in range(elems.shape[0]):
+            a, b = elems[e, 0], elems[e, 1]
+            hit = True
+            for r in range(3):
+                if hi[r] < min(x[a, r], x[b, r]) or lo[r] > max(x[a, r], x[b, r]):
+                    hit = False
+                    break
+            if hit:
+                cand[k] = e
+                k += 1
+    start[parts.kind.shape[0]] = k
+    return k
+
+
+@njit(cache=True)
+def pose_at(parts, j, tau, c, R):
+    """The part's predicted centre of mass c (3,) and rotation R (3,3) at tau (s) into the
+    step: c0 + v tau + a tau^2 / 2, and R0 turned by the spin over tau (Rodrigues)."""
+    w = parts.spins[j]
+    R0 = parts.rotations[j]
+    for r in range(3):
+        c[r] = (parts.centres[j, r] + parts.velocities[j, r] * tau
+                + 0.5 * parts.accels[j, r] * tau * tau)
+    wn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    th = wn * tau
+    if th < 1e-12:
+        for a in range(3):
+            for b in range(3):
+                R[a, b] = R0[a, b]
+        return
+    kx, ky, kz = w[0] / wn, w[1] / wn, w[2] / wn
+    s, cm = np.sin(th), 1.0 - np.cos(th)
+    # exp([k] th) = I + sin th [k] + (1 - cos th) [k]^2
+    E00, E01, E02 = 1.0 - cm * (ky * ky + kz * kz), -s * kz + cm * kx * ky, s * ky + cm * kx * kz
+    E10, E11, E12 = s * kz + cm * kx * ky, 1.0 - cm * (kx * kx + kz * kz), -s * kx + cm * ky * kz
+    E20, E21, E22 = -s * ky + cm * kx * kz, s * kx + cm * ky * kz, 1.0 - cm * (kx * kx + ky * ky)
+    for b in range(3):
+        R[0, b] = E00 * R0[0, b] + E01 * R0[1, b] + E02 * R0[2, b]
+        R[1, b] = E10 * R0[0, b] + E11 * R0[1, b] + E12 * R0[2, b]
+        R[2, b] = E20 * R0[0, b] + E21 * R0[1, b] + E22 * R0[2, b]
+
+
+@njit(cache=True, inline="always")
+def _local_sd(l0, l1, l2, h0, h1, h2):
+    """Signed distance (m) of a point (l0, l1, l2) in a box's frame from the box of half
+    extents h0, h1, h2 centred there."""
+    q0, q1, q2 = abs(l0) - h0, abs(l1) - h1, abs(l2) - h2
+    if q0 > 0.0 or q1 > 0.0 or q2 > 0.0:
+        e0, e1, e2 = max(q0, 0.0), max(q1, 0.0), max(q2, 0.0)
+        return np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    return max(q0, max(q1, q2))
+
+
+@njit(cache=True)
+def _box_sd(C, R, half, px, py, pz, g):
+    """Signed distance (m) of point p from a box (centre C, rotation R, half extents) and the
+    outward unit normal there, in the world, into g."""
+    dx, dy, dz = px - C[0], py - C[1], pz - C[2]
+    l0 = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz
+    l1 = R[0, 1] * dx + R[1, 1] * dy + R[2, 1] * dz
+    l2 = R[0, 2] * dx + R[1, 2] * dy + R[2, 2] * dz
+    q0, q1, q2 = abs(l0) - half[0], abs(l1) - half[1], abs(l2) - half[2]
+    if q0 > 0.0 or q1 > 0.0 or q2 > 0.0:
+        e0, e1, e2 = max(q0, 0.0), max(q1, 0.0), max(q2, 0.0)
+        d = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        u0 = (e0 if l0 >= 0.0 else -e0) / d
+        u1 = (e1 if l1 >= 0.0 else -e1) / d
+        u2 = (e2 if l2 >= 0.0 else -e2) / d
+    else:  # inside: out through the nearest face
+        d = max(q0, max(q1, q2))
+        u0 = (1.0 if l0 >= 0.0 else -1.0) if d == q0 else 0.0
+        u1 = (1.0 if l1 >= 0.0 else -1.0) if (d == q1 and d != q0) else 0.0
+        u2 = (1.0 if l2 >= 0.0 else -1.0) if (d == q2 and d != q0 and d != q1) else 0.0
+    for r in range(3):
+        g[r] = R[r, 0] * u0 + R[r, 1] * u1 + R[r, 2] * u2
+    return d
+
+
+@njit(cache=True, inline="always")
+def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
+    """Deepest approach of a part's primitive (kind, p, q, size as in Parts; the part at
+    centre c, rotation R) to element ia-ib: returns (the element's parameter t in [0,1],
+    signed gap s: distance from the part's surface, negative inside); writes the element's
+    contact point X, the part's surface point P and the unit normal n (element towards
+    part). A, B are scratch (3,)."""
+    for r in range(3):
+        A[r] = c[r] + R[r, 0] * p[0] + R[r, 1] * p[1] + R[r, 2] * p[2]
+    xa, xb = x[ia], x[ib]
+    if kind == BOX:
+        # the element in the box's frame: the signed distance along it is then a cheap
+        # function of t, convex, minimised by golden-section search
+        ax, ay, az = xa[0] - A[0], xa[1] - A[1], xa[2] - A[2]
+        a0 = R[0, 0] * ax + R[1, 0] * ay + R[2, 0] * az
+        a1 = R[0, 1] * ax + R[1, 1] * ay + R[2, 1] * az
+        a2 = R[0, 2] * ax + R[1, 2] * ay + R[2, 2] * az
+        bx, by, bz = xb[0] - A[0], xb[1] - A[1], xb[2] - A[2]
+        e0 = R[0, 0] * bx + R[1, 0] * by + R[2, 0] * bz - a0
+        e1 = R[0, 1] * bx + R[1, 1] * by + R[2, 1] * bz - a1
+        e2 = R[0, 2] * bx + R[1, 2] * by + R[2, 2] * bz - a2
+        h0, h1, h2 = size[0], size[1], size[2]
+        t = 0.0
+        if ia != ib:
+            lo, hi = 0.0, 1.0
+            gr = 0.6180339887498949
+            t1, t2 = 1.0 - gr, gr
+            f1 = _local_sd(a0 + t1 * e0, a1 + t1 * e1, a2 + t1 * e2, h0, h1, h2)
+            f2 = _local_sd(a0 + t2 * e0, a1 + t2 * e1, a2 + t2 * e2, h0, h1, h2)
+            for _ in range(GOLDEN_ITERATIONS):
+                if f1 <= f2:
+                    hi, t2, f2 = t2, t1, f1
+                    t1 = hi - gr * (hi - lo)
+                    f1 = _local_sd(a0 + t1 * e0, a1 + t1 * e1, a2 + t1 * e2, h0, h1, h2)
+                else:
+                    lo, t1, f1 = t1, t2, f2
+                    t2 = lo + gr * (hi - lo)
+                    f2 = _local_sd(a0 + t2 * e0, a1 + t2 * e1, a2 + t2 * e2, h0, h1, h2)
+            # a convex function's minimum may sit at an end of the segment
+            t = 0.5 * (lo + hi)
+            best = _local_sd(a0 + t * e0, a1 + t * e1, a2 + t * e2, h0, h1, h2)
+            f0 = _local_sd(a0, a1, a2, h0, h1, h2)
+            if f0 < best:
+                t, best = 0.0, f0
+            fe = _local_sd(a0 + e0, a1 + e1, a2 + e2, h0, h1, h2)
+            if fe < best:
+                t = 1.0
+        for r in range(3):
+            X[r] = xa[r] + t * (xb[r] - xa[r])
+        s = _box_sd(A, R, size, X[0], X[1], X[2], n)
+        for r in range(3):
+            P[r] = X[r] - s * n[r]  # the box's surface point nearest X
+            n[r] = -n[r]  # outward from the box points at the element: flip to element -> part
+        return t, s
+    radius = size[0]
+    if kind == CAPSULE:
+        for r in range(3):
+            B[r] = c[r] + R[r, 0] * q[0] + R[r, 1] * q[1] + R[r, 2] * q[2]
+        sa, t = _segments(A, B, xa, xb)
+        for r in range(3):
+            A[r] += sa * (B[r] - A[r])  # the axis point nearest the element
+    else:
+        ex, ey, ez = xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]
+        L2 = ex * ex + ey * ey + ez * ez
+        t = 0.0 if L2 <= 0.0 else min(1.0, max(0.0, ((A[0] - xa[0]) * ex + (A[1] - xa[1]) * ey
+                                                     + (A[2] - xa[2]) * ez) / L2))
+    d2 = 0.0
+    for r in range(3):
+        X[r] = xa[r] + t * (xb[r] - xa[r])
+        n[r] = A[r] - X[r]
+        d2 += n[r] * n[r]
+    d = np.sqrt(d2)
+    if d <= 0.0:  # the element passes through the axis: push along +z (does not happen at rest)
+        n[0], n[1], n[2] = 0.0, 0.0, 1.0
+    else:
+        for r in range(3):
+            n[r] /= d
+    for r in range(3):
+        P[r] = A[r] - radius * n[r]
+    return t, d - radius
+
+
+@njit(cache=True, inline="always")
+def _segments(p1, q1, p2, q2):
+    """Parameters (s, t) of the closest points of segments p1-q1 and p2-q2 (Ericson 5.1.9,
+    scalar: no temporaries)."""
+    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
+    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
+    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    tiny = 1e-30
+    if a <= tiny and e <= tiny:
+        return 0.0, 0.0
+    if a <= tiny:
+        return 0.0, min(1.0, max(0.0, f / e))
+    c = d1x * rx + d1y * ry + d1z * rz
+    if e <= tiny:
+        return min(1.0, max(0.0, -c / a)), 0.0
+    b = d1x * d2x + d1y * d2y + d1z * d2z
+    den = a * e - b * b
+    s = min(1.0, max(0.0, (b * f - c * e) / den)) if den > 1e-14 * a * e else 0.0
+    t = (b * s + f) / e
+    if t < 0.0:
+        return min(1.0, max(0.0, -c / a)), 0.0
+    if t > 1.0:
+        return min(1.0, max(0.0, (b - c) / a)), 1.0
+    return s, t
+
+
+class Touches(NamedTuple):
+    """Scratch for one substep's contacts (capacity c, the step's candidates): part (c,),
+    element ends ia, ib (c,), parameter t (c,), penetration pen (c,) m, normal n (c,3)
+    (element towards part), part surface point P (c,3) m and its velocity vp (c,3) m/s;
+    per part its predicted centre of mass c (k,3) m at the substep; per network point the
+    summed closest-point weight share (n,) of its contacts (zero between substeps)."""
+    part: np.ndarray
+    ia: np.ndarray
+    ib: np.ndarray
+    t: np.ndarray
+    pen: np.ndarray
+    n: np.ndarray
+    P: np.ndarray
+    vp: np.ndarray
+    c: np.ndarray
+    share: np.ndarray
+
+
+def touches(capacity: int, parts: int, points: int) -> Touches:
+    """Empty Touches for up to ``capacity`` contacts of ``parts`` parts on ``points`` points."""
+    return Touches(np.zeros(capacity, np.int64), np.zeros(capacity, np.int64),
+                   np.zeros(capacity, np.int64), np.zeros(capacity), np.zeros(capacity),
+                   np.zeros((capacity, 3)), np.zeros((capacity, 3)), np.zeros((capacity, 3)),
+                   np.zeros((parts, 3)), np.zeros(points))
+
+
+@njit(cache=True)
+def find_touches(parts, tau, x, tc):
+    """Pass 1 at tau (s) into the step: every candidate element within its part's contact
+    skin, into the Touches ``tc``, and each touched point's summed weight (1 - t at ia, t at
+    ib) into tc.share. Returns the count."""
+    R = np.empty((3, 3))
+    lo, hi = np.empty(3), np.empty(3)
+    A, B, X, P, n = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    cand, elems = parts.cand, parts.elems
+    cnt = 0
+    for j in range(parts.kind.shape[0]):
+        if parts.start[j + 1] == parts.start[j]:
+            continue
+        c = tc.c[j]
+        pose_at(parts, j, tau, c, R)
+        thickness = parts.law[j, THICKNESS]
+        _primitive_box(parts, j, c, R, lo, hi)
+        kind, pj, qj, size = parts.kind[j], parts.p[j], parts.q[j], parts.size[j]
+        w, lin, acc = parts.spins[j], parts.velocities[j], parts.accels[j]
+        for e in range(parts.start[j], parts.start[j + 1]):
+            ia, ib = elems[cand[e], 0], elems[cand[e], 1]
+            if (hi[0] + thickness < min(x[ia, 0], x[ib, 0])
+                    or lo[0] - thickness > max(x[ia, 0], x[ib, 0])
+                    or hi[1] + thickness < min(x[ia, 1], x[ib, 1])
+                    or lo[1] - thickness > max(x[ia, 1], x[ib, 1])
+                    or hi[2] + thickness < min(x[ia, 2], x[ib, 2])
+                    or lo[2] - thickness > max(x[ia, 2], x[ib, 2])):
+                continue  # the element's box misses the primitive's: no contact this substep
+            t, gap = closest(kind, pj, qj, size, c, R, x, ia, ib, A, B, X, P, n)
+            pen = thickness - gap
+            if pen <= 0.0:
+                continue
+            tc.part[cnt], tc.ia[cnt], tc.ib[cnt], tc.t[cnt], tc.pen[cnt] = j, ia, ib, t, pen
+            rx, ry, rz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
+            for r in range(3):
+                tc.n[cnt, r] = n[r]
+                tc.P[cnt, r] = P[r]
+            # the part's surface velocity at P: v + a tau + w x r
+            tc.vp[cnt, 0] = lin[0] + acc[0] * tau + w[1] * rz - w[2] * ry
+            tc.vp[cnt, 1] = lin[1] + acc[1] * tau + w[2] * rx - w[0] * rz
+            tc.vp[cnt, 2] = lin[2] + acc[2] * tau + w[0] * ry - w[1] * rx
+            if ia == ib:
+                tc.share[ia] += 1.0
+            else:
+                tc.share[ia] += 1.0 - t
+                tc.share[ib] += t
+            cnt += 1
+    return cnt
+
+
+@njit(cache=True)
+def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
+    """Pass 2: the law at each of the ``cnt`` Touches. A network point touched by several
+    contacts (a bed point under a foot is an end of six edges) lends each a share of its mass
+    in proportion to the contact's weight on it, m_p w / W_p (W_p its summed weight), so the
+    point sees one contact's stiffness, damping and constraint force in total, not six: the
+    contact's inverse mass is 1/m_part + sum_p w W_p / m_p. Writes the forces on the points
+    into the PointForces ``out`` (one entry per point of a contact, equal and opposite to the
+    part's; Jacobians and vref when ``with_jacobian``) and each part's force (0:3) and torque
+    about its centre of mass (3:6) into ``wrenches`` (k,6); clears tc.share. dt (s): the
+    step the forces are held for (friction's cap; its inverse over ``parts.steps`` the law's
+    rate where the law gives no stiffness). Returns the entries written."""
+    x, v, m, _ = pts
+    out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
+    omega = 1.0 / (parts.steps * dt)
+    wrenches[:, :] = 0.0
+    vrel, vt, F = np.empty(3), np.empty(3), np.empty(3)
+    k = 0
+    for i in range(cnt):
+        j, ia, ib, t = tc.part[i], tc.ia[i], tc.ib[i], tc.t[i]
+        law = parts.law[j]
+        mu, eps = law[FRICTION], law[EPS]
+        wa, wb = (1.0, 0.0) if ia == ib else (1.0 - t, t)
+        n = tc.n[i]
+        vn = 0.0
+        an = 0.0
+        for r in range(3):
+            vrel[r] = tc.vp[i, r] - (wa * v[ia, r] + wb * v[ib, r])
+            vn += vrel[r] * n[r]
+            an += (parts.accels[j, r] - (wa * pt_acc[ia, r] + wb * pt_acc[ib, r])) * n[r]
+        inv_m = 1.0 / parts.masses[j] + wa * tc.share[ia] / m[ia]
+        if ib != ia:
+            inv_m += wb * tc.share[ib] / m[ib]
+        meff = 1.0 / inv_m
+        cs = law[STIFFNESS] if law[STIFFNESS] >= 0.0 else meff * omega * omega
+        cd = law[DAMPING] if law[DAMPING] >= 0.0 else 2.0 * meff * omega
+        fn = normal_force(tc.pen[i], vn, an, inv_m, cs, cd, law[CONSTRAINT] > 0.5)
+        if fn <= 0.0:
+            continue
+        vtn = 0.0
+        for r in range(3):
+            vt[r] = vrel[r] - vn * n[r]
+            vtn += vt[r] * vt[r]
+        vtn = np.sqrt(vtn)
+        ft = -sliding_friction(fn, vtn, mu, eps, inv_m, dt) / vtn if vtn > 0.0 else 0.0
+        for r in range(3):
+            F[r] = fn * n[r] + ft * vt[r]
+        rx, ry, rz = (tc.P[i, 0] - tc.c[j, 0], tc.P[i, 1] - tc.c[j, 1],
+                      tc.P[i, 2] - tc.c[j, 2])
+        wrenches[j, 0] += F[0]
+        wrenches[j, 1] += F[1]
+        wrenches[j, 2] += F[2]
+        wrenches[j, 3] += ry * F[2] - rz * F[1]
+        wrenches[j, 4] += rz * F[0] - rx * F[2]
+        wrenches[j, 5] += rx * F[1] - ry * F[0]
+        visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
+        for side in range(1 if ia == ib else 2):
+            pi = ia if side == 0 else ib
+            wgt = wa if side == 0 else wb
+            out_idx[k] = pi
+            for a in range(3):
+                out_f[k, a] = -wgt * F[a]
+            if with_jacobian:
+                for a in range(3):
+                    out_vref[k, a] = tc.vp[i, a]
+                    for b in range(3):
+                        nn = n[a] * n[b]
+                        tan = (1.0 if a == b else 0.0) - nn
+                        out_dfdx[k, a, b] = -wgt * wgt * cs * nn
+                        out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
+            k += 1
+    for i in range(cnt):
+        tc.share[tc.ia[i]] = 0.0
+        tc.share[tc.ib[i]] = 0.0
+    return k
