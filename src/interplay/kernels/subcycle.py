@@ -18,6 +18,26 @@ from .springs import Load, PointForces, implicit_step, network_forces, symplecti
 
 
 @njit(cache=True)
+def _scatter(out, count, f, load, implicit):
+    """Add the first ``count`` entries of the PointForces ``out`` to the points: to the
+    forces f (N) of an explicit substep, or to an implicit substep's held Load (forces, their
+    Jacobians, and dfdx . vref)."""
+    for e in range(count):
+        p = out.idx[e]
+        for a in range(3):
+            if not implicit:
+                f[p, a] += out.f[e, a]
+                continue
+            load.f[p, a] += out.f[e, a]
+            s_ = 0.0
+            for b in range(3):
+                load.kext[p, a, b] += out.dfdx[e, a, b]
+                load.dext[p, a, b] += out.dfdv[e, a, b]
+                s_ += out.dfdx[e, a, b] * out.vref[e, b]
+            load.kvref[p, a] += s_
+
+
+@njit(cache=True)
 def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems):
     """Advance the Network by h in nsub substeps, the Colliders ``cols`` against its elements
     ``elems`` (segments (s,2), or points as (p, p) pairs) re-evaluated every substep.
@@ -89,19 +109,7 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
             fmag = np.sqrt(wrench[0] ** 2 + wrench[1] ** 2 + wrench[2] ** 2)
             if fmag > impulses[q, 6]:
                 impulses[q, 6] = fmag
-            for e in range(cnt):
-                p = out.idx[e]
-                for a in range(3):
-                    if not implicit:
-                        f[p, a] += out.f[e, a]
-                        continue
-                    fe[p, a] += out.f[e, a]
-                    s_ = 0.0
-                    for b in range(3):
-                        ke[p, a, b] += out.dfdx[e, a, b]
-                        de[p, a, b] += out.dfdv[e, a, b]
-                        s_ += out.dfdx[e, a, b] * out.vref[e, b]
-                    kv[p, a] += s_
+            _scatter(out, cnt, f, sub_load, implicit)
         if implicit:
             implicit_step(net, sub_load, f, dt, scheme, has_prev or step > 0)
         else:
@@ -168,19 +176,9 @@ def advance_with_parts(net, load, f, h, nsub, scheme, has_prev, parts):
                 tz += wrenches[j, 2]
             parts.peak[0] = max(parts.peak[0], np.sqrt(tx * tx + ty * ty + tz * tz))
         for e in range(entries):
-            p = out.idx[e]
             for a in range(3):
                 received[a] += out.f[e, a] * dt
-                if not implicit:
-                    f[p, a] += out.f[e, a]
-                    continue
-                fe[p, a] += out.f[e, a]
-                s_ = 0.0
-                for b in range(3):
-                    ke[p, a, b] += out.dfdx[e, a, b]
-                    de[p, a, b] += out.dfdv[e, a, b]
-                    s_ += out.dfdx[e, a, b] * out.vref[e, b]
-                kv[p, a] += s_
+        _scatter(out, entries, f, sub_load, implicit)
         if implicit:
             implicit_step(net, sub_load, f, dt, scheme, has_prev or step > 0)
         else:
