@@ -70,6 +70,9 @@ def main(argv=None):
     from ..scenes import all_specs, spec
     specs = [spec(n) for n in a.scenes.split(",")] if a.scenes else all_specs()
     out = Path(a.out)
+    index = out / "gallery.json"
+    # the stills of scenes not asked for stay listed: --scenes redoes some of the gallery
+    kept = {r["scene"]: r for r in (json.loads(index.read_text()) if index.exists() else [])}
     records = []
     for s in specs:
         img, rec = still(s)
@@ -79,8 +82,9 @@ def main(argv=None):
         print(f"{s.name}: t = {rec['time_s']:.2f} s, the moving systems fill "
               f"{rec['subject_height_fraction']:.2f} of the frame's height, the primary "
               f"({rec['primary']}) {rec['primary_height_fraction']:.2f}", flush=True)
-    with atomic_path(out / "gallery.json") as tmp:
-        tmp.write_text(json.dumps(records, indent=2))
+    kept.update({r["scene"]: r for r in records})
+    with atomic_path(index) as tmp:
+        tmp.write_text(json.dumps([kept[k] for k in sorted(kept)], indent=2))
 
 
 if __name__ == "__main__":
