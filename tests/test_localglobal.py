@@ -6,6 +6,7 @@ import pytest
 import scipy.sparse as sp
 
 from interplay.geometry import shapes
+from interplay.kernels import global_matrix as GM
 from interplay.kernels import localglobal as LG
 from interplay.kernels import springs as K
 from interplay.kernels.contact import colliders
@@ -44,8 +45,8 @@ def test_lu_solve_matches_the_matrix():
     net = cloth("localglobal", 1 / 60)
     h, alpha, beta = 1 / 60, 0.3, 1e-3
     net.alpha = alpha
-    fid, A_lg = LG.system_matrix(net.bundle(), beta, h)
-    lu = LG.factor(A_lg)
+    fid, A_lg = GM.system_matrix(net.bundle(), beta, h)
+    lu = GM.factor(A_lg)
     n, free = len(net.m), ~net.fixed
     w = (h * h + h * beta) * net.k
     lap = sp.coo_matrix((np.r_[w, w, -w, -w], (np.r_[net.si, net.sj, net.si, net.sj],
@@ -54,7 +55,7 @@ def test_lu_solve_matches_the_matrix():
     A = (sp.diags(net.m * (1 + h * alpha)) + lap).tocsr()[free][:, free]
     b = np.random.default_rng(0).normal(size=(int(free.sum()), 3))
     out = np.empty_like(b)
-    LG.ldl_solve(lu, b, np.empty_like(b), out)
+    GM.ldl_solve(lu, b, np.empty_like(b), out)
     assert np.allclose(A @ out, b, rtol=0, atol=1e-12 * np.abs(b).max())
     assert np.array_equal(fid[free], np.arange(free.sum())) and np.all(fid[~free] == -1)
 

@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse.linalg as sla
 
 from interplay.geometry import shapes
-from interplay.kernels import localglobal as LG
+from interplay.kernels import global_matrix as GM
 from interplay.kernels import multigrid as MG
 from interplay.systems.springmass import SpringNetwork
 
@@ -18,7 +18,7 @@ def cloth_matrix(n):
     x, t = shapes.grid(1.0, 1.0, n, n)
     net = SpringNetwork.from_mesh("c", x, t, 0.15, 200.0, dt=H, integrator="localglobal",
                                   mass_damping=ALPHA, stiffness_damping=BETA, fixed=[0, n - 1])
-    _, A = LG.system_matrix(net.bundle(), BETA, H)
+    _, A = GM.system_matrix(net.bundle(), BETA, H)
     return A.tocsr()
 
 

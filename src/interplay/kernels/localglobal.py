@@ -17,8 +17,7 @@ and with p held the objective is quadratic with the constant matrix
 A = M (1 + h alpha) + (h^2 + h beta) L + h^2 K_anchor + h C_anchor,
 L = sum_s k_s (e_a - e_b)(e_a - e_b)^T (the *global* solve): x - A^-1 grad Phi is one plain
 local/global iteration. A bounds the damping's Hessian (u u^T <= I), does not depend on the
-state, and is factored once (``factor``: SuperLU as L D L^T) or given a multigrid hierarchy
-(``multigrid``). L-BFGS builds on A^-1 the curvature the projections leave out, with an Armijo
+state, and is factored once or given a multigrid hierarchy (kernels/global_matrix.py). L-BFGS builds on A^-1 the curvature the projections leave out, with an Armijo
 line search (the objective never rises). With memory 0 it is plain local/global.
 
 Fixed points are not unknowns. External forces (aero, contacts, attachments) enter y
@@ -33,32 +32,11 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from .contact import DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS, Sphere
 from .contact_law import backward_euler_normal, sliding_friction
-from .multigrid import Hierarchy, Workspace, vcycle
+from .global_matrix import apply_inverse
 from .springs import Points, SpringSet
-
-
-class Direct(NamedTuple):
-    """The factor A[perm][:, perm] = L D L^T: the strict lower part of L in CSC (Lp, Li, Lx),
-    dinv = 1 / D and perm (the position of each unknown in the permuted system)."""
-    Lp: np.ndarray
-    Li: np.ndarray
-    Lx: np.ndarray
-    dinv: np.ndarray
-    perm: np.ndarray
-
-
-class Factors(NamedTuple):
-    """What applies A^-1: fid (n,) each point's unknown (-1 for fixed points), and either the
-    Direct factor or a multigrid Hierarchy with its Workspace (the unused one empty)."""
-    fid: np.ndarray
-    direct: Direct
-    mg: Hierarchy
-    work: Workspace
 
 
 class History(NamedTuple):
@@ -90,109 +68,6 @@ class Settings(NamedTuple):
     beta: float
     iters: int
     tol: float
-
-
-def system_matrix(net, beta, h):
-    """The global matrix for step h (s) over the free points of a springs.Network, and each
-    point's index among them. beta (s): the stiffness-proportional damping. Returns (fid (n,),
-    -1 for fixed points; A, scipy CSC, kg)."""
-    m, fixed = net.pts.m, net.pts.fixed
-    si, sj, k = net.springs.i, net.springs.j, net.springs.k
-    a_idx, a_k, a_c = net.anchors.idx, net.anchors.k, net.anchors.c
-    alpha = net.alpha
-    n = len(m)
-    free = ~fixed
-    fid = np.full(n, -1, dtype=np.int64)
-    fid[free] = np.arange(int(free.sum()))
-    w = (h * h + h * beta) * k
-    Lap = sp.coo_matrix((np.r_[w, w, -w, -w],
-                         (np.r_[si, sj, si, sj], np.r_[si, sj, sj, si])), shape=(n, n)).tocsr()
-    diag = m * (1.0 + h * alpha)
-    np.add.at(diag, a_idx, h * h * a_k + h * a_c)
-    return fid, (sp.diags(diag) + Lap).tocsr()[free][:, free].tocsc()
-
-
-def factor(A):
-    """A = P^T L D L^T P for ``ldl_solve``: (Lp, Li, Lx, dinv, perm)."""
-    # A is symmetric positive definite: without row pivoting SuperLU's U is D L^T, so only the
-    # unit lower factor and the diagonal are kept (half the memory; at 128^2 the factor then
-    # fits in cache and a solve takes 2.4 instead of 4.6 ms)
-    lu = sla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                  options={"SymmetricMode": True})
-    if not np.array_equal(lu.perm_r, lu.perm_c):
-        raise RuntimeError("local/global: SuperLU pivoted a symmetric positive definite matrix")
-    Lf = lu.L.tocsc()
-    Lf.sort_indices()
-    strict = np.ones(Lf.nnz, dtype=bool)
-    strict[Lf.indptr[:-1]] = False  # each column's first entry is the unit diagonal
-    cols = np.repeat(np.arange(Lf.shape[1]), np.diff(Lf.indptr))
-    L = sp.csc_matrix((Lf.data[strict], (Lf.indices[strict], cols[strict])), shape=Lf.shape)
-    L.sort_indices()
-    # position i of the permuted system holds unknown perm[i]
-    perm = np.empty_like(lu.perm_c)
-    perm[lu.perm_c] = np.arange(len(perm))
-    # 32-bit row indices: the triangular solves are memory-bound (12 instead of 16 bytes a nonzero)
-    return Direct(L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
-                  1.0 / lu.U.diagonal(), perm.astype(np.int64))
-
-
-# what a preconditioner slot holds when the other one is in use (same types: one compilation)
-NO_DIRECT = Direct(np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0), np.zeros(0),
-                   np.zeros(0, np.int64))
-NO_MULTIGRID = Hierarchy(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(1, np.int64),
-                         np.zeros(0, np.int32), np.zeros(0), np.zeros(1, np.int64),
-                         np.zeros(0, np.int32), np.zeros(0), np.zeros(0), np.zeros((0, 0)))
-NO_WORKSPACE = Workspace(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)))
-
-
-@njit(cache=True)
-def _apply_h0(pre, q, z):
-    """q <- A^-1 q (approximately) with the Factors ``pre``: one multigrid V-cycle when it has
-    levels, else the factored solve; z is scratch."""
-    if pre.mg.sizes.shape[0] > 0:
-        vcycle(pre.mg, pre.work, q, z)
-        q[:] = z
-    else:
-        ldl_solve(pre.direct, q, z, q)
-
-
-@njit(cache=True)
-def ldl_solve(direct, b, z, out):
-    """Solve A out = b for three right-hand sides (columns) with the Direct factor; z is
-    scratch."""
-    Lp, Li, Lx, dinv, perm = direct
-    n = b.shape[0]
-    for i in range(n):
-        r = perm[i]
-        z[i, 0] = b[r, 0]
-        z[i, 1] = b[r, 1]
-        z[i, 2] = b[r, 2]
-    for j in range(n):  # L y = b, column by column
-        z0 = z[j, 0]
-        z1 = z[j, 1]
-        z2 = z[j, 2]
-        for e in range(Lp[j], Lp[j + 1]):
-            i = Li[e]
-            z[i, 0] -= Lx[e] * z0
-            z[i, 1] -= Lx[e] * z1
-            z[i, 2] -= Lx[e] * z2
-    for j in range(n - 1, -1, -1):  # L^T out = D^-1 y: column j of L is row j of L^T
-        s0 = z[j, 0] * dinv[j]
-        s1 = z[j, 1] * dinv[j]
-        s2 = z[j, 2] * dinv[j]
-        for e in range(Lp[j], Lp[j + 1]):
-            i = Li[e]
-            s0 -= Lx[e] * z[i, 0]
-            s1 -= Lx[e] * z[i, 1]
-            s2 -= Lx[e] * z[i, 2]
-        z[j, 0] = s0
-        z[j, 1] = s1
-        z[j, 2] = s2
-    for i in range(n):
-        r = perm[i]
-        out[r, 0] = z[i, 0]
-        out[r, 1] = z[i, 1]
-        out[r, 2] = z[i, 2]
 
 
 @njit(cache=True)
@@ -365,7 +240,8 @@ def _axpy_dot(q, a, y, s):
 @njit(cache=True)
 def _lbfgs(x, obj, pre, hist, work, iters, tol, phis):
     """Minimize the Objective's Phi by L-BFGS with A as the initial Hessian (Liu, Bouaziz &
-    Kavan 2017; its inverse applied by ``_apply_h0`` with the Factors ``pre``) and a
+    Kavan 2017; its inverse applied by ``global_matrix.apply_inverse`` with the Factors
+    ``pre``) and a
     backtracking Armijo line search. hist: the History ring; the last min(count, mem) pairs
     are live, and the slot after them is where the next pair is written (kept only if its
     curvature s.y is positive). work: (g, gn, q, z, xt) scratch. Stops after ``iters``
@@ -401,7 +277,7 @@ def _lbfgs(x, obj, pre, hist, work, iters, tol, phis):
             alpha[c] = rho[c] * acc
             older = (stored - 2 - j) % slots  # the next pair's s . q, fused (unused at the end)
             acc = _axpy_dot(q, alpha[c], Y[c], S[older] if j + 1 < live else Y[c])
-        _apply_h0(pre, q, z)
+        apply_inverse(pre, q, z)
         acc = 0.0
         if live > 0:
             acc = _dot(Y[(stored - live) % slots], q)

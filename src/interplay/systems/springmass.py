@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
                       require_positive)
+from ..kernels import global_matrix as GM
 from ..kernels import localglobal as LG
 from ..kernels import multigrid as MG
 from ..kernels import parallel as PAR
@@ -394,12 +395,12 @@ class SpringNetwork(System):
         key = (h, self.alpha, self.beta, self.lg_solver, self.lg_memory)
         if (lg is None or lg[0] != key
                 or not all(np.array_equal(a, b) for a, b in zip(arrays, lg[1]))):
-            fid, A = LG.system_matrix(self.bundle(), self.beta, h)
+            fid, A = GM.system_matrix(self.bundle(), self.beta, h)
             if self._multigrid(A.shape[0]):
                 hier = MG.hierarchy(A)
-                pre = LG.Factors(fid, LG.NO_DIRECT, hier, MG.workspace(hier))
+                pre = GM.Factors(fid, GM.NO_DIRECT, hier, MG.workspace(hier))
             else:
-                pre = LG.Factors(fid, LG.factor(A), LG.NO_MULTIGRID, LG.NO_WORKSPACE)
+                pre = GM.Factors(fid, GM.factor(A), GM.NO_MULTIGRID, GM.NO_WORKSPACE)
             # L-BFGS pairs (kept across steps while the matrix is unchanged) and their count
             nf, slots = A.shape[0], self.lg_memory + 1
             history = LG.History(np.zeros((slots, nf, 3)), np.zeros((slots, nf, 3)),
