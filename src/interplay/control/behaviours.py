@@ -31,6 +31,14 @@ def crouch(name="crouch", next=None, after=0.6, depth=1.0, lean=0.3) -> State:
                  support=True, balance=STANCE_BALANCE, transitions=trans, blend=0.5 * after)
 
 
+def tip(name="tip", next=None, ankle=0.0, lead=0.0, after=1.5) -> State:
+    """Lean out over the toes on the feet (``ankle`` rad): hands over when the centre of mass
+    is ``lead`` m ahead of them, or after ``after`` s even if the lean never gets that far."""
+    return State(name, pose=(("ankle", ankle),), support=True, blend=0.1,
+                 transitions=(Transition("com_ahead", next, lead),
+                              Transition("time", next, after)))
+
+
 def leap(name="leap", next=None, after=0.35, power=1.0, arm_swing=2.6, hip=-0.1) -> State:
     """Extend hips (to ``hip`` rad of flexion: below 0 a vertical jump, above 0 a forward
     dive), knees and ankles together (a timed push, velocity targets scaled by power) while the

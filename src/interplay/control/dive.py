@@ -126,12 +126,9 @@ def takeoff(p: DiveParams) -> tuple:
 def controller(p: DiveParams, level: float = 0.0) -> Controller:
     """stand -> crouch -> tip -> take-off (push, leave) -> reach -> pike -> open (to the end);
     level (m): the height of the still water surface."""
-    tip = State("tip", pose=(("ankle", p.tip_ankle),), support=True, blend=0.1,
-                transitions=(Transition("com_ahead", "takeoff", p.lead),
-                             Transition("time", "takeoff", TIP_MAX)))
     return Controller((B.stand(next="crouch", after=p.stand),
                        B.crouch(next="tip", after=p.crouch, depth=p.depth, lean=p.lean),
-                       tip,
+                       B.tip(next="takeoff", ankle=p.tip_ankle, lead=p.lead, after=TIP_MAX),
                        *takeoff(p),
                        pike(next="open", pitch=p.opening, spot=p.spot, below=level + OPEN_BY,
                             hip=p.pike),

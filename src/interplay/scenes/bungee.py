@@ -18,7 +18,7 @@ import numpy as np
 
 from ..control import behaviours as B
 from ..control.search import Search
-from ..control.fsm import Controller, State, Transition
+from ..control.fsm import Controller
 from ..geometry.anthropometry import SEGMENTS, BodyParams
 from ..geometry.setpieces import bridge
 from ..interactions.attachment import AttachmentParams, SegmentAttachment
@@ -102,12 +102,9 @@ class BungeeParams:
 def controller(p: JumperParams) -> Controller:
     """stand -> crouch -> tip -> leap -> tuck (the feet clear the edge) -> layout (the rest
     of the flight, the bounces and the hang)."""
-    tip = State("tip", pose=(("ankle", p.tip_ankle),), support=True, blend=0.1,
-                transitions=(Transition("com_ahead", "leap", p.lead),
-                             Transition("time", "leap", TIP_MAX)))
     return Controller((B.stand(next="crouch", after=p.stand),
                        B.crouch(next="tip", after=p.crouch, depth=p.depth, lean=p.lean),
-                       tip,
+                       B.tip(next="leap", ankle=p.tip_ankle, lead=p.lead, after=TIP_MAX),
                        B.leap(next="tuck", power=p.power, arm_swing=p.arm_swing, hip=p.hip),
                        B.tuck(next="layout", after=p.tuck),
                        B.layout()), start="stand")
