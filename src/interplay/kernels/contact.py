@@ -99,7 +99,6 @@ def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrenc
     """
     c, vc, w, radius, ball_mass, ball_acc = ball
     x, v, m, _ = pts
-    out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
     thickness, cs, cd, mu, eps = law[THICKNESS], law[STIFFNESS], law[DAMPING], law[FRICTION], law[EPS]
     constraint = law[CONSTRAINT] > 0.5
     for q in range(6):
@@ -164,21 +163,37 @@ def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrenc
         # Jacobians of the point forces: penalty along n; damping along n; friction in the
         # tangent plane (the law's secant damping)
         visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
-        for side in range(1 if ia == ib else 2):
-            p = ia if side == 0 else ib
-            wgt = wa if side == 0 else wb
-            out_idx[k] = p
+        k = to_segment_ends(out, k, (ia, ib, wa, wb), F, n, vball, (cs, cd, visc),
+                            with_jacobian)
+    return k
+
+
+@njit(cache=True)
+def to_segment_ends(out, k, ends, F, n, vref, gains, with_jacobian):
+    """Write -F (N, the reaction of a contact force F on the other body) to a segment's ends
+    (ia, ib, wa, wb: point indices and barycentric weights; one entry when ia == ib) in the
+    PointForces ``out`` from entry k, with the Jacobians when ``with_jacobian``: the penalty's
+    c_s and the damping's c_d along the normal n, the friction's secant damping visc in the
+    tangent plane (gains = (c_s, c_d, visc)), relative to the other body's velocity vref.
+    Returns the next free entry."""
+    out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
+    ia, ib, wa, wb = ends
+    cs, cd, visc = gains
+    for side in range(1 if ia == ib else 2):
+        p = ia if side == 0 else ib
+        wgt = wa if side == 0 else wb
+        out_idx[k] = p
+        for a in range(3):
+            out_f[k, a] = -wgt * F[a]
+        if with_jacobian:
             for a in range(3):
-                out_f[k, a] = -wgt * F[a]
-            if with_jacobian:
-                for a in range(3):
-                    out_vref[k, a] = vball[a]
-                    for b in range(3):
-                        nn = n[a] * n[b]
-                        out_dfdx[k, a, b] = -wgt * wgt * cs * nn
-                        tan = (1.0 if a == b else 0.0) - nn
-                        out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
-            k += 1
+                out_vref[k, a] = vref[a]
+                for b in range(3):
+                    nn = n[a] * n[b]
+                    out_dfdx[k, a, b] = -wgt * wgt * cs * nn
+                    tan = (1.0 if a == b else 0.0) - nn
+                    out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
+        k += 1
     return k
 
 

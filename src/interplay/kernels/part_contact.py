@@ -20,7 +20,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS
+from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS, to_segment_ends
 from .contact_law import friction_damping, normal_force, sliding_friction
 
 SPHERE, CAPSULE, BOX = 0, 1, 2
@@ -404,7 +404,6 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
     step the forces are held for (friction's cap; its inverse over ``parts.steps`` the law's
     rate where the law gives no stiffness). Returns the entries written."""
     x, v, m, _ = pts
-    out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
     omega = 1.0 / (parts.steps * dt)
     wrenches[:, :] = 0.0
     vrel, vt, F = np.empty(3), np.empty(3), np.empty(3)
@@ -447,21 +446,8 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
         wrenches[j, 4] += rz * F[0] - rx * F[2]
         wrenches[j, 5] += rx * F[1] - ry * F[0]
         visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
-        for side in range(1 if ia == ib else 2):
-            pi = ia if side == 0 else ib
-            wgt = wa if side == 0 else wb
-            out_idx[k] = pi
-            for a in range(3):
-                out_f[k, a] = -wgt * F[a]
-            if with_jacobian:
-                for a in range(3):
-                    out_vref[k, a] = tc.vp[i, a]
-                    for b in range(3):
-                        nn = n[a] * n[b]
-                        tan = (1.0 if a == b else 0.0) - nn
-                        out_dfdx[k, a, b] = -wgt * wgt * cs * nn
-                        out_dfdv[k, a, b] = -wgt * wgt * (cd * nn + visc * tan)
-            k += 1
+        k = to_segment_ends(out, k, (ia, ib, wa, wb), F, n, tc.vp[i], (cs, cd, visc),
+                            with_jacobian)
     for i in range(cnt):
         tc.share[tc.ia[i]] = 0.0
         tc.share[tc.ib[i]] = 0.0
