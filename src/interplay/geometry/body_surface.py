@@ -366,6 +366,21 @@ class BodySurface:
             p -= (f / np.maximum(np.sum(g * g, axis=1), 1e-12))[:, None] * g
         return p
 
+    def mesh_distance(self, points, vertices=None, reach: float = 0.1):
+        """(signed distance (n,) m, outward normal (n,3)) of points from the skin mesh (at
+        ``vertices``, default the A-pose): the triangles garments collide with, which lie up
+        to a chord's sag off ``sdf`` (inf beyond reach)."""
+        from ..kernels.skin_contact import signed_distance, vertex_normals
+        from .aabb_tree import AABBTree
+        X = self.vertices0 if vertices is None else np.asarray(vertices, float)
+        p = np.ascontiguousarray(points, float)
+        tri, d, bary = AABBTree(X, self.triangles).nearest(p, reach)
+        vn = np.zeros_like(X)
+        vertex_normals(X, self.triangles, vn)
+        s, n = np.full(len(p), np.inf), np.zeros_like(p)
+        signed_distance(p, tri, bary, d, X, self.triangles, vn, s, n)
+        return s, n
+
     def _weights(self, v, start, nbr) -> np.ndarray:
         d = segment_distances(v, self.solids, self.pos0, self.rot0)
         nearest = np.argmin(d, axis=1)

@@ -77,7 +77,7 @@ class Fit:
     band_ease: float = param(0.004, "m", ge=0.0, le=0.1)
     length: float = param(0.5, "-", ge=0.05, le=1.5)
     elastic: float = param(0.92, "-", ge=0.5, le=1.0)
-    min_gap: float = param(0.004, "m", ge=0.0, le=0.05)
+    min_gap: float = param(0.008, "m", ge=0.0, le=0.05)
     flare: float = param(14.0, "deg", ge=0.0, le=60.0)
     split: float = param(1.6, "-", ge=1.2, le=10.0)
 
@@ -254,13 +254,19 @@ def _finish(name, b, surface, fabric, fit, groups, rings, sizes) -> Garment:
     # where a sleeve or leg blends from its armhole or crotch loop into rings about the limb,
     # or the panels close at a seam, some edges come out long: split them
     x, t, groups, rings = split_long_edges(x, t, groups, rings, fit.split * fit.spacing)
+    # and where rows crowd (a crotch loop's chain beside the first leg row) edges come out
+    # short: a short edge is a stiff spring that a millimetre's contact push strains by tens
+    # of percent. Even the edges out towards [0.6, 1.6] spacings (position-based passes)
+    x = even_out(x, t, 0.6 * fit.spacing, fit.split * fit.spacing)
     # dressing's first step: nothing closer to the body than min_gap
-    for _ in range(3):
-        d = surface.sdf(x)
+    # (against the skin's triangles, which the cloth collides with: in a crease they stand
+    # off the smooth body by a chord's sag)
+    for _ in range(4):
+        d, n = surface.mesh_distance(x)
         close = d < fit.min_gap
         if not close.any():
             break
-        x[close] = surface.project(x[close], level=fit.min_gap + 1e-4)
+        x[close] += (fit.min_gap + 1e-4 - d[close])[:, None] * n[close]
     if rings:
         re = np.concatenate([r[0] for r in rings])
         rf = np.concatenate([np.full(len(r[0]), r[1]) for r in rings])
@@ -269,6 +275,30 @@ def _finish(name, b, surface, fabric, fit, groups, rings, sizes) -> Garment:
     g = Garment(name, x, t, fabric, groups, re, rf, sizes)
     check_garment(g, surface)
     return g
+
+
+def even_out(x, t, lo, hi, passes: int = 300):
+    """Positions moved so that every edge's length is within [lo, hi] (m), as nearly as
+    ``passes`` Jacobi passes of position-based length constraints reach (each edge outside
+    the range moves its two ends half the excess each, averaged over the edges at a point)."""
+    e, _, _ = mesh_edges(t)
+    x = np.array(x, float)
+    for _ in range(passes):
+        d = x[e[:, 1]] - x[e[:, 0]]
+        length = np.linalg.norm(d, axis=1)
+        target = np.clip(length, lo, hi)
+        bad = np.abs(target - length) > 1e-6 * hi
+        if not bad.any():
+            break
+        corr = ((length - target) / np.maximum(length, 1e-12))[:, None] * d * 0.5
+        corr[~bad] = 0.0
+        move = np.zeros_like(x)
+        count = np.zeros(len(x))
+        np.add.at(move, e[:, 0], corr)
+        np.add.at(move, e[:, 1], -corr)
+        np.add.at(count, e[bad].ravel(), 1.0)
+        x += move / np.maximum(count, 1.0)[:, None]
+    return x
 
 
 def split_long_edges(x, t, groups, rings, max_len):
@@ -532,6 +562,8 @@ def sweatpants(surface: BodySurface, fit: Fit = Fit(ease=0.025),
     chain = b.add(chain_x)  # back to front
     groups = {"waist": rows[0].copy(),
               "waistband": np.concatenate([r for z, r in zip(zs, rows) if z > z_w - band])}
+    # the elastic band grips: its points ride the skin (systems.garments.Garments.ride)
+    groups["pinned"] = groups["waistband"].copy()
     rings = [(_ring_edges([r for z, r in zip(zs, rows) if z > z_w - band]), fit.elastic)]
     sizes = {"waist_girth": float(_circumference(np.concatenate(b.x)[rows[0]])),
              "hip_girth": _circumference(probe), "columns": N}
@@ -566,7 +598,10 @@ def sweatpants(surface: BodySurface, fit: Fit = Fit(ease=0.025),
         cuff = [r for z, r in zip(zl, lrows) if z < z_cuff + band]
         groups[f"cuff_{side}"] = lrows[-1].copy()
         groups[f"cuffband_{side}"] = np.concatenate(cuff)
-        rings.append((_ring_edges(cuff), fit.elastic))
+        # the cuffs are cut to the ankle with band_ease, at rest (not pre-stretched): an
+        # elastic cuff contracting around the ankle against the skin contact caught on the
+        # foot in the first steps (a stiff ring in a position-level contact)
+        rings.append((_ring_edges(cuff), 1.0))
         sizes[f"inseam_{side}"] = float(z_c - z_cuff)
     groups["crotch_seam"] = chain.copy()
     return _finish(name, b, surface, fabric, fit, groups, rings, sizes)
@@ -594,6 +629,7 @@ def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
     rows = []
     waist = _ring(surface, hips, np.array([0.0, 0.0, z_w]), np.array([1.0, 0, 0]),
                   np.array([0, 1.0, 0]), th, fit.band_ease)
+    # (the skirt's waistband grips like the pants')
     r_w = np.linalg.norm(waist[:, :2], axis=1)
     tan = np.tan(np.radians(fit.flare))
     band = 0.03
@@ -608,7 +644,7 @@ def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
         b.band(a, c)
     bandrows = [r for z, r in zip(zs, rows) if z > z_w - band]
     groups = {"waist": rows[0].copy(), "waistband": np.concatenate(bandrows),
-              "hem": rows[-1].copy()}
+              "hem": rows[-1].copy(), "pinned": np.concatenate(bandrows)}
     sizes = {"waist_girth": _circumference(waist), "length": float(z_w - z_hem),
              "hem_girth": _circumference(np.concatenate(b.x)[rows[-1]]), "columns": N}
     return _finish(name, b, surface, fabric, fit, groups,
@@ -725,6 +761,11 @@ def check_start(g: Garment, surface: BodySurface) -> None:
 LATTICE = np.sqrt(3.0) / 2.0
 
 
+#: N: the pull of an elastic band's webbing along the band when worn (a waistband holds a pair
+#: of sweat pants, ~0.3 kg, by friction of mu ~0.5 over its pressure: 2 pi T mu >> m g)
+BAND_TENSION = 3.0
+
+
 def spring_set(g: Garment):
     """(Springs, kinds (s,), masses (n,)) of a garment: structural springs on its edges at
     k = LATTICE x tensile stiffness, shear springs across quad diagonals at k = LATTICE x
@@ -754,7 +795,11 @@ def spring_set(g: Garment):
         factor = dict(zip(key(g.ring_edges).tolist(), g.ring_factor.tolist()))
         kk = key(ms.pairs)
         scale = np.array([factor.get(int(v), 1.0) for v in kk])
-        rest = rest * np.where(ms.kind == 0, scale, 1.0)
+        band = (ms.kind == 0) & (scale != 1.0)
+        rest = rest * np.where(band, scale, 1.0)
+        # the band's elastic webbing sewn into the fabric: BAND_TENSION (N) at rest
+        k = np.where(band, np.maximum(k, BAND_TENSION / np.maximum(1.0 / scale - 1.0, 1e-3)
+                                      / rest), k)
     springs = Springs(ms.pairs[:, 0].copy(), ms.pairs[:, 1].copy(), rest, k,
                       np.zeros(len(rest), bool))
     return springs, ms.kind, ms.masses
@@ -762,15 +807,14 @@ def spring_set(g: Garment):
 
 def network(g: Garment, dt: float = 1.0 / 240.0, integrator: str = "localglobal",
             mass_damping: float = 0.3, stiffness_damping: float = 0.0, color=None, **kw):
-    """The garment's SpringNetwork (systems/springmass.py), drawn as cloth; ``spring_kind``
-    and ``garment`` are kept on it."""
-    from ..systems.springmass import SpringNetwork
+    """The garment's network (systems/garments.Garments: a SpringNetwork that certifies
+    itself against the skin it is worn on), drawn as cloth."""
+    from ..systems.garments import Garments
     springs, kind, masses = spring_set(g)
-    net = SpringNetwork(g.name, g.vertices.copy(), masses, springs, dt=dt, integrator=integrator,
-                        mass_damping=mass_damping, stiffness_damping=stiffness_damping,
-                        triangles=g.triangles, color=color, **kw)
-    net.spring_kind = kind
-    net.garment = g
+    net = Garments(g.name, g.vertices.copy(), masses, springs, dt=dt, integrator=integrator,
+                   mass_damping=mass_damping, stiffness_damping=stiffness_damping,
+                   triangles=g.triangles, color=color, **kw)
+    net.setup(g, kind)
     return net
 
 
