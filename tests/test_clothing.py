@@ -86,9 +86,9 @@ def test_the_panels_sew_into_closed_garments_of_the_stated_size(surface):
         assert counts.max() <= 2, name
         assert len(G.boundary_loops(g.triangles)) == openings, name
         made[name] = g
-    loose = G.tee(surface, G.Fit(spacing=0.02, ease=0.04)).sizes["chest_girth"]
+    loose = G.tee(surface, G.Fit(spacing=0.02, ease=0.03)).sizes["chest_girth"]
     chest = made["tee"].sizes["chest_girth"]
-    growth = 2 * np.pi * (0.04 - fit.ease)
+    growth = 2 * np.pi * (0.03 - fit.ease)
     assert abs(loose - chest - growth) < 0.15 * growth
     P = {s.name: k for k, s in enumerate(surface.plan)}
     ankle = surface.pos0[P["l_foot"], 2]
@@ -144,15 +144,17 @@ def test_a_cloth_square_at_5_m_per_s_onto_the_thigh_does_not_tunnel(surface):
     h = 1 / 240
     X, V = surface.vertices0, np.zeros_like(surface.vertices0)
     proj = _Projector(net, surface.triangles, SkinContactParams(), X)
+    touched = 0
     for _ in range(24):
         net.clear_forces()
         proj.start()
         net.advance(h)
         proj.resolve(X, V, h)
+        touched = max(touched, proj.count)
     s, _ = surface.mesh_distance(net.x)
     assert s.min() > 0.0
     assert len(AABBTree(X, surface.triangles).intersections(AABBTree(net.x, net.triangles))) == 0
-    assert proj.count > 0  # it did land
+    assert touched > 20  # it did land
 
 
 def _slope_skin(theta):

@@ -253,20 +253,24 @@ def _finish(name, b, surface, fabric, fit, groups, rings, sizes) -> Garment:
     rings = [(new[r], f) for r, f in rings]
     # where a sleeve or leg blends from its armhole or crotch loop into rings about the limb,
     # or the panels close at a seam, some edges come out long: split them
-    x, t, groups, rings = split_long_edges(x, t, groups, rings, fit.split * fit.spacing)
-    # and where rows crowd (a crotch loop's chain beside the first leg row) edges come out
-    # short: a short edge is a stiff spring that a millimetre's contact push strains by tens
-    # of percent. Even the edges out towards [0.6, 1.6] spacings (position-based passes)
-    x = even_out(x, t, 0.6 * fit.spacing, fit.split * fit.spacing)
-    # dressing's first step: nothing closer to the body than min_gap
-    # (against the skin's triangles, which the cloth collides with: in a crease they stand
-    # off the smooth body by a chord's sag)
-    for _ in range(4):
-        d, n = surface.mesh_distance(x)
-        close = d < fit.min_gap
-        if not close.any():
+    for _ in range(3):  # the push out of the body may lengthen edges again: split anew
+        x, t, groups, rings = split_long_edges(x, t, groups, rings, fit.split * fit.spacing)
+        # and where rows crowd (a crotch loop's chain beside the first leg row) edges come
+        # out short: a short edge is a stiff spring that a millimetre's contact push strains
+        # by tens of percent. Even the edges out towards [0.6, 1.6] spacings
+        x = even_out(x, t, 0.6 * fit.spacing, fit.split * fit.spacing)
+        # dressing's first step: nothing closer to the body than min_gap (against the skin's
+        # triangles, which the cloth collides with: in a crease they stand off the smooth
+        # body by a chord's sag)
+        for _ in range(4):
+            d, n = surface.mesh_distance(x)
+            close = d < fit.min_gap
+            if not close.any():
+                break
+            x[close] += (fit.min_gap + 1e-4 - d[close])[:, None] * n[close]
+        e, _, _ = mesh_edges(t)
+        if np.linalg.norm(x[e[:, 0]] - x[e[:, 1]], axis=1).max() <= fit.split * fit.spacing:
             break
-        x[close] += (fit.min_gap + 1e-4 - d[close])[:, None] * n[close]
     if rings:
         re = np.concatenate([r[0] for r in rings])
         rf = np.concatenate([np.full(len(r[0]), r[1]) for r in rings])
