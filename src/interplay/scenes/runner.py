@@ -44,7 +44,7 @@ class RunnerParams:
     tee: Fit = Fit(spacing=0.016)
     pants: Fit = Fit(spacing=0.016, ease=0.025)
     contact: SkinContactParams = SkinContactParams()
-    self_thickness: float = param(0.003, "m", ge=0.0, le=0.05)
+    self_thickness: float = param(0.0, "m", ge=0.0, le=0.05)
     cloth_dt: float = param(1.0 / 240.0, "s", ge=1e-5, le=0.02)
     lg_iterations: int = param(10, "iterations", ge=1, le=500)
     dress_s: float = param(0.0, "s", ge=0.0, le=10.0)
@@ -227,4 +227,4 @@ SPEC = SceneSpec(
     camera=TrackingCamera("runner", offset=(0.9, -3.2, 0.35), target_offset=(0.0, 0.0, 0.0),
                           axes=(1.0, 1.0, 0.0), hold=(0.0, 0.0, 1.0), fov_deg=35.0,
                           smooth_s=0.4),
-    key_time=1.0, figures=figures)
+    key_time=1.0, figures=figures, heavy=True)
