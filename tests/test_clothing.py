@@ -196,3 +196,19 @@ def test_friction_holds_below_the_cone_and_slides_by_coulomb_above(theta_deg, mu
         g = 9.81
         want = 0.5 * g * (np.sin(theta) - mu * np.cos(theta)) * (steps * h) ** 2
         assert moved == pytest.approx(want, rel=0.03)
+
+
+def test_the_keyframed_run_is_a_clip_the_figure_plays(tmp_path):
+    """Without motion capture the runner plays a keyframed run: a BVH the reader and the
+    retargeting take (metres from centimetres), moving forward at its speed (3.2 m/s within
+    5%: the root's forward channel is speed x t) with its feet near the ground."""
+    from interplay.scenes.runner import keyframed_run
+    path = tmp_path / "run.bvh"
+    keyframed_run(path, duration=1.0)
+    fig = MocapFigure("runner", path, units="cm", skip_tpose=False, ground=0.0)
+    fig.set_time(0.0)
+    x0 = fig.segment_positions()[0].copy()
+    fig.set_time(0.9)
+    moved = np.linalg.norm(fig.segment_positions()[0][:2] - x0[:2])
+    assert moved == pytest.approx(3.2 * 0.9, rel=0.05)
+    assert 0.7 < fig.body.height < 2.5
