@@ -57,10 +57,10 @@ PANTS_COLOR = (0.10, 0.11, 0.14)  # charcoal fleece
 
 def keyframed_run(path, duration: float = 2.0, cadence: float = 2.8, speed: float = 3.2,
                   fps: float = 120.0) -> None:
-    """Write a BVH of a keyframed run (CMU joint names, centimetres... in metres x 100): the
-    root moves forward at ``speed`` (m/s) and bobs at twice the step rate; hips, knees,
-    shoulders and elbows swing as the first harmonics of a running gait at ``cadence``
-    strides per second... (steps per second / 2)."""
+    """Write a BVH of a keyframed run (CMU joint names, lengths in cm, y up, z forward): the
+    root moves forward at ``speed`` (m/s) and bobs at the step rate; hips, knees, ankles and
+    arms swing as the first harmonic of a running gait at ``cadence`` steps per second (the
+    stride at half that), the elbows bent, the spine leaning 8 deg forward."""
     names = ["Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg",
              "RightFoot", "RightToeBase", "Spine", "Spine1", "Head", "LeftShoulder", "LeftArm",
              "LeftForeArm", "LeftHand", "RightShoulder", "RightArm", "RightForeArm",

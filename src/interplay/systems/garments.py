@@ -26,7 +26,7 @@ import numpy as np
 from ..errors import SceneError
 from ..geometry.aabb_tree import AABBTree
 from ..kernels.skin_contact import signed_distance, vertex_normals
-from .springmass import SpringNetwork
+from .springmass import SpringNetwork, Springs
 
 
 class Garments(SpringNetwork):
@@ -251,3 +251,64 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
     if not np.all(np.isfinite(net.x)):
         raise SceneError(f"{net.name}: dressing blew up; use a smaller step")
     return out
+
+
+# --- a garment as a spring-mass network ----------------------------------------------------
+#: a triangular lattice of springs k has the sheet stiffness Y = 2 k / sqrt(3) (per unit width
+#: per unit strain), whatever its spacing: k = sqrt(3) / 2 Y for the structural springs
+LATTICE = np.sqrt(3.0) / 2.0
+
+
+#: N: the pull of an elastic band's webbing along the band when worn (a waistband holds a pair
+#: of sweat pants, ~0.3 kg, by friction of mu ~0.5 over its pressure: 2 pi T mu >> m g)
+BAND_TENSION = 3.0
+
+
+def spring_set(g: Garment):
+    """(Springs, kinds (s,), masses (n,)) of a garment: structural springs on its edges at
+    k = LATTICE x tensile stiffness, shear springs across quad diagonals at k = LATTICE x
+    shear, bending springs across the other interior edges at k = 3 B / l0^2 (B the bending
+    rigidity, N m: a hinge of two edges of length l0 resisting a fold), masses by area at the
+    fabric's areal density. Elastic rings rest at ``ring_factor`` of their cut length."""
+    from ..geometry.mesh import mesh_springs
+    if g.parts:
+        sets, base = [], 0
+        for p in g.parts:
+            sp, kd, m = spring_set(p)
+            sets.append((Springs(sp.i + base, sp.j + base, sp.rest, sp.stiffness,
+                                 sp.tension_only), kd, m))
+            base += len(p.vertices)
+        return (Springs.concat(*[a for a, _, _ in sets]), np.concatenate([b for _, b, _ in sets]),
+                np.concatenate([c for _, _, c in sets]))
+    f = g.fabric
+    ms = mesh_springs(g.vertices, g.triangles, g.mass, "area", g.name)
+    x = g.vertices
+    rest = np.linalg.norm(x[ms.pairs[:, 0]] - x[ms.pairs[:, 1]], axis=1)
+    k = np.choose(ms.kind, [np.full(len(rest), LATTICE * f.tensile),
+                            np.full(len(rest), LATTICE * f.shear),
+                            3.0 * f.bending / rest ** 2])
+    if len(g.ring_edges):
+        key = lambda p: np.sort(p, axis=1) @ np.array([len(x), 1])  # noqa: E731
+        factor = dict(zip(key(g.ring_edges).tolist(), g.ring_factor.tolist()))
+        kk = key(ms.pairs)
+        scale = np.array([factor.get(int(v), 1.0) for v in kk])
+        band = (ms.kind == 0) & (scale != 1.0)
+        rest = rest * np.where(band, scale, 1.0)
+        # the band's elastic webbing sewn into the fabric: BAND_TENSION (N) at rest
+        k = np.where(band, np.maximum(k, BAND_TENSION / np.maximum(1.0 / scale - 1.0, 1e-3)
+                                      / rest), k)
+    springs = Springs(ms.pairs[:, 0].copy(), ms.pairs[:, 1].copy(), rest, k,
+                      np.zeros(len(rest), bool))
+    return springs, ms.kind, ms.masses
+
+
+def network(g: Garment, dt: float = 1.0 / 240.0, integrator: str = "localglobal",
+            mass_damping: float = 0.3, stiffness_damping: float = 0.0, color=None, **kw):
+    """The garment's network (systems/garments.Garments: a SpringNetwork that certifies
+    itself against the skin it is worn on), drawn as cloth."""
+    springs, kind, masses = spring_set(g)
+    net = Garments(g.name, g.vertices.copy(), masses, springs, dt=dt, integrator=integrator,
+                   mass_damping=mass_damping, stiffness_damping=stiffness_damping,
+                   triangles=g.triangles, color=color, **kw)
+    net.setup(g, kind)
+    return net
