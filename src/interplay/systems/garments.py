@@ -164,9 +164,28 @@ class Garments(SpringNetwork):
         return out
 
     def capture(self):
+        """The network's state and the certificates so far (one row per frame: t,
+        crossings, penetration, self-crossings, then each stretch key's value)."""
         snap = super().capture()
-        snap["cert_frames"] = np.array([len(self.certificates)])
+        keys = sorted(self.certificates[0]["stretch"]) if self.certificates else []
+        rows = [[c["t"], c["cloth_body_intersections"], c["penetration_m"],
+                 c["self_intersections"], *(c["stretch"][k] for k in keys)]
+                for c in self.certificates]
+        snap["cert"] = np.array(rows, float).reshape(len(rows), 4 + len(keys))
+        snap["cert_keys"] = np.array(keys, dtype=str)
         return snap
+
+    def restore(self, snap):
+        snap = dict(snap)
+        rows, keys = snap.pop("cert", None), snap.pop("cert_keys", None)
+        super().restore(snap)
+        if rows is not None:
+            keys = [str(k) for k in np.asarray(keys).ravel()]
+            self.certificates = [
+                {"t": float(r[0]), "cloth_body_intersections": int(r[1]),
+                 "penetration_m": float(r[2]), "self_intersections": int(r[3]),
+                 "stretch": {k: float(v) for k, v in zip(keys, r[4:])}}
+                for r in np.asarray(rows, float).reshape(-1, 4 + len(keys))]
 
 
 def _slerp(R0, R1, f):
