@@ -33,5 +33,11 @@ def print_run(console, result):
     console.print(table)
     adv = result.advice()
     console.print(f"advice: [bold]{adv['mode']}[/bold] - " + "; ".join(adv["reasons"]))
+    # the other interactions on a moving primary (a figure's vest beside its noose)
+    for it in result.interactions:
+        if it["name"] != result.main and it["primary_role"] == "dynamic":
+            other = result.advice_for(it)
+            console.print(f"advice for {it['name']}: [bold]{other['mode']}[/bold] - "
+                          + "; ".join(other["reasons"]))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/yellow] {w}")
