@@ -89,8 +89,10 @@ class OwlCreekParams:
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
 
 
-# hands bound behind the back: shoulders extended, elbows bent, the wrists crossed
-BOUND = (("shoulder_flex", -0.45), ("shoulder_abd", -0.05), ("elbow", 1.0), ("wrist", 0.0))
+# hands bound behind the back: shoulders extended and turned in, elbows bent, so the wrists
+# cross behind the small of the back (12 cm behind the pelvis, at the midline)
+BOUND = (("shoulder_flex", -0.5), ("shoulder_abd", 0.0), ("shoulder_rot", -1.2),
+         ("elbow", 1.3), ("wrist", 0.0))
 
 
 def controller(opens: float) -> Controller:
@@ -101,8 +103,10 @@ def controller(opens: float) -> Controller:
                   transitions=(Transition("time", "hang", opens),), blend=0.3)
     hang = State("hang", pose=(("hip", 0.0), ("knee", 0.05), ("ankle", -0.3), ("waist", 0.0),
                                ("neck", 0.0), ("toe", 0.0)) + BOUND,
+                 # the bound arms are held together behind him by the cord round the wrists,
+                 # which stiff arm servos stand in for (the jerk would throw free arms)
                  gains=(("hip", 8.0), ("knee", 8.0), ("ankle", 8.0), ("waist", 10.0),
-                        ("neck", 10.0)), blend=0.3)
+                        ("neck", 10.0), ("shoulder", 45.0), ("elbow", 45.0)), blend=0.3)
     return Controller((stand, hang), start="stand")
 
 
