@@ -14,6 +14,9 @@ from interplay.scenes import all_specs, spec
 from interplay.systems.base import Role
 
 SCENES = [s.name for s in all_specs()]
+# scenes whose build takes tens of seconds: the tests that build them many times are slow
+LIGHT = [pytest.param(s.name, marks=pytest.mark.slow) if s.heavy else s.name
+         for s in all_specs()]
 SHORT = 0.05  # s: a few coupling steps of every scene
 
 
@@ -181,7 +184,7 @@ def one_line_or_success(capsys, argv):
     return code, err
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", LIGHT)
 def test_every_cli_verb_on_every_scene_exits_0_or_prints_one_line(name, tmp_path, capsys):
     out = str(tmp_path / name)
     assert one_line_or_success(capsys, ["run", name, "--out", out, *QUICK])[0] == 0

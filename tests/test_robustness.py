@@ -59,7 +59,8 @@ def one_line_or_finite(code, err, out):
     return None
 
 
-@pytest.mark.parametrize("name", MODULES)
+@pytest.mark.parametrize("name", [pytest.param(m, marks=pytest.mark.slow) if spec(m).heavy
+                                  else m for m in MODULES])
 def test_fuzz_every_parameter_of_every_scene(name, tmp_path_factory, capsys):
     sp = spec(name)
     domains = P.domains(sp.params())

@@ -7,7 +7,7 @@ from ..errors import SceneError
 
 #: the scene modules, loaded on demand (a scene's module imports its systems)
 MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "owl_creek", "pond",
-           "puddle", "stunt_kite", "trampoline")
+           "puddle", "runner", "stunt_kite", "trampoline")
 
 
 def spec(name: str):

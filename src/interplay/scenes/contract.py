@@ -24,7 +24,9 @@ class SceneSpec:
     the moment its figure shows (the ball in the net), the gallery's still; figures: result ->
     {label: value}, the scene's own key figures (the basketball's exit speed) for summaries
     and compare tables; searches: the ``control.search.Search``es ``interplay tune`` can run
-    on it (the first is the default).
+    on it (the first is the default); heavy: its build alone takes tens of seconds (the
+    runner cuts and dresses garments), so the every-scene tests that build it many times
+    (the fuzz, every CLI verb) run it only in the slow suite.
     """
     name: str
     description: str
@@ -40,6 +42,7 @@ class SceneSpec:
     key_time: float | None = None
     figures: Callable | None = field(default=None, compare=False)
     searches: tuple = field(default=(), compare=False)
+    heavy: bool = False
 
     @property
     def default_coupling(self) -> str:

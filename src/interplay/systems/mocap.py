@@ -43,6 +43,7 @@ for _k in list(NAMES):
         NAMES["r" + _k[1:]] = (tuple(n.replace("Left", "Right") for n in j),
                                tuple(n.replace("Left", "Right").replace("lhand", "rhand")
                                      for n in b))
+SKIN_COLOR = (0.80, 0.56, 0.42)  # linear RGB
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 1e-3, "inch": 0.0254, "cmu": 0.0254 / 0.45}
 TYPICAL_LEG = 0.85  # m, hip to ankle of an adult: picks the unit that makes the legs human
 
@@ -176,6 +177,7 @@ class MocapFigure(System, RigidParts):
         self._x = self._spline(0.0)
         self._v = self._d_spline(0.0)
         self.color = None
+        self.skin = None
         prims = [segment_primitive(sg.shape) for sg in self.plan]
         self._middle = np.array([pr.middle for pr in prims])  # m, segment frame
         self._view = BodiesView(self, SEGMENTS, self.segment_meshes(), prims,
@@ -310,8 +312,16 @@ class MocapFigure(System, RigidParts):
         self._v = np.array(xdot, dtype=float)
 
     def frame(self):
-        return {"segment_positions": self.segment_positions().copy(),
-                "segment_orientations": self.segment_orientations().copy()}
+        out = {"segment_positions": self.segment_positions().copy(),
+               "segment_orientations": self.segment_orientations().copy()}
+        if self.skin is not None:
+            out["points"] = self.skin.pose(*self.part_poses())
+        return out
+
+    def wear_skin(self, surface) -> None:
+        """Draw and export the figure as its skinned body surface (geometry.body_surface):
+        one deforming mesh, per-frame points, instead of one mesh per segment."""
+        self.skin = surface
 
     def segment_meshes(self) -> list:
         return [segment_mesh(s.shape) for s in self.plan]
@@ -344,11 +354,28 @@ class MocapFigure(System, RigidParts):
         lin = self._v[:51].reshape(17, 3) + np.cross(ang, self.part_centres() - pos)
         return lin, ang
 
+    def pose_at(self, t: float):
+        """(positions (17,3), rotations (17,3,3), linear velocities at the centres, angular
+        velocities, centres) of the segments at time t (s), leaving the figure where it is:
+        what a contact resolved at the end of a step needs of the clip there."""
+        keep = self._x, self._v
+        try:
+            self._sample(t)
+            pos, R = self.part_poses()
+            lin, ang = self.part_velocities()
+            return pos.copy(), R, lin, ang, self.part_centres()
+        finally:
+            self._x, self._v = keep
+
     def centre_of_mass(self):
         m = np.array([sg.mass for sg in self.plan])
         return (m[:, None] * self.part_centres()).sum(axis=0) / m.sum()
 
     def shapes(self):
+        if self.skin is not None:
+            from .shape import Shape
+            return [Shape(self.name, "surface", color=self.color or SKIN_COLOR,
+                          triangles=self.skin.triangles, palette="rigid", material="skin")]
         return [figure_shape(self.name, self.plan, self.color)]
 
 

@@ -1,0 +1,163 @@
+"""Cloth points against a moving, skinned body surface (one-way): projection with Coulomb
+friction, and the exact certificates (penetration depth of points).
+
+Notation (SI): the body's vertices X (nb,3) m and velocities V (nb,3) m/s at the end of the
+step, its triangles (mb,3) wound outward; the cloth's Points (x, v, m, fixed); each point's
+nearest body triangle ``tri`` (-1: none within reach), its closest point's barycentric
+weights ``bary``, its signed distance ``s`` (m, negative inside) and outward normal ``nrm``
+(kernels.trimesh_contact.signed_triangle_distance).
+"""
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+
+class Skin(NamedTuple):
+    """The body at the end of the step: vertices X (nb,3) m, velocities V (nb,3) m/s,
+    triangles (mb,3)."""
+    X: np.ndarray
+    V: np.ndarray
+    tris: np.ndarray
+
+
+class Nearest(NamedTuple):
+    """Each cloth point's nearest body triangle (-1 none), barycentric weights (n,3), signed
+    distance s (n,) m and outward normal (n,3)."""
+    tri: np.ndarray
+    bary: np.ndarray
+    s: np.ndarray
+    nrm: np.ndarray
+
+
+class Law(NamedTuple):
+    """thickness (m): the gap kept between cloth and skin; friction mu (-); h (s): the step
+    the velocity changes are impulses over."""
+    thickness: float
+    friction: float
+    h: float
+
+
+@njit(cache=True)
+def project(pts, x0, skin, near, law, dv):
+    """Resolve the step that took the points from x0 (n,3) to pts.x: every point that ended
+    closer than the thickness to the skin moves out along the normal to the thickness, and
+    friction acts on its slip over the step (its displacement relative to the skin's,
+    tangent to the skin) in position form (Macklin et al. 2014, "Unified particle physics for
+    real-time applications", section 6.1): the slip is undone when it is at most mu times the
+    normal correction (sticking), else shortened by that much (sliding). Its velocity becomes
+    the skin's plus that slip per step, and its own normal velocity away from the skin, if any
+    (no bounce from the correction itself). dv (n,3) receives each point's velocity change
+    (m/s, zero elsewhere); returns the contacts."""
+    count = 0
+    h = law.h
+    for i in range(pts.x.shape[0]):
+        dv[i, 0] = dv[i, 1] = dv[i, 2] = 0.0
+        e = near.tri[i]
+        if e < 0 or pts.fixed[i] or near.s[i] >= law.thickness:
+            continue
+        count += 1
+        a, b, c = skin.tris[e, 0], skin.tris[e, 1], skin.tris[e, 2]
+        w0, w1, w2 = near.bary[i, 0], near.bary[i, 1], near.bary[i, 2]
+        nx, ny, nz = near.nrm[i, 0], near.nrm[i, 1], near.nrm[i, 2]
+        push = law.thickness - near.s[i]
+        vbx = w0 * skin.V[a, 0] + w1 * skin.V[b, 0] + w2 * skin.V[c, 0]
+        vby = w0 * skin.V[a, 1] + w1 * skin.V[b, 1] + w2 * skin.V[c, 1]
+        vbz = w0 * skin.V[a, 2] + w1 * skin.V[b, 2] + w2 * skin.V[c, 2]
+        # the step's displacement relative to the skin's, and its tangential part
+        rx = pts.x[i, 0] - x0[i, 0] - vbx * h
+        ry = pts.x[i, 1] - x0[i, 1] - vby * h
+        rz = pts.x[i, 2] - x0[i, 2] - vbz * h
+        rn = rx * nx + ry * ny + rz * nz
+        tx, ty, tz = rx - rn * nx, ry - rn * ny, rz - rn * nz
+        slip = np.sqrt(tx * tx + ty * ty + tz * tz)
+        cap = law.friction * push
+        keep = 0.0 if slip <= cap else 1.0 - cap / slip
+        # corrected end position: pushed out, slip undone or shortened
+        pts.x[i, 0] += push * nx - (1.0 - keep) * tx
+        pts.x[i, 1] += push * ny - (1.0 - keep) * ty
+        pts.x[i, 2] += push * nz - (1.0 - keep) * tz
+        # velocity: the skin's, the kept slip per step, and any normal velocity away
+        ux, uy, uz = pts.v[i, 0] - vbx, pts.v[i, 1] - vby, pts.v[i, 2] - vbz
+        un = max(ux * nx + uy * ny + uz * nz, 0.0)
+        nvx = vbx + keep * tx / h + un * nx
+        nvy = vby + keep * ty / h + un * ny
+        nvz = vbz + keep * tz / h + un * nz
+        dv[i, 0], dv[i, 1], dv[i, 2] = nvx - pts.v[i, 0], nvy - pts.v[i, 1], nvz - pts.v[i, 2]
+        pts.v[i, 0], pts.v[i, 1], pts.v[i, 2] = nvx, nvy, nvz
+    return count
+
+
+@njit(cache=True)
+def reaction(x, m, dv, h, centre):
+    """Force (N) and torque (N m, about centre) the cloth's velocity changes dv over h put on
+    the body: minus the cloth's momentum change per time."""
+    f = np.zeros(3)
+    tau = np.zeros(3)
+    for i in range(x.shape[0]):
+        if dv[i, 0] == 0.0 and dv[i, 1] == 0.0 and dv[i, 2] == 0.0:
+            continue
+        fx, fy, fz = -m[i] * dv[i, 0] / h, -m[i] * dv[i, 1] / h, -m[i] * dv[i, 2] / h
+        f[0] += fx
+        f[1] += fy
+        f[2] += fz
+        rx, ry, rz = x[i, 0] - centre[0], x[i, 1] - centre[1], x[i, 2] - centre[2]
+        tau[0] += ry * fz - rz * fy
+        tau[1] += rz * fx - rx * fz
+        tau[2] += rx * fy - ry * fx
+    return f, tau
+
+
+@njit(cache=True)
+def vertex_normals(X, tris, out):
+    """Area-weighted unit vertex normals (nb,3) of a closed outward-wound mesh."""
+    out[:] = 0.0
+    for t in range(tris.shape[0]):
+        a, b, c = tris[t, 0], tris[t, 1], tris[t, 2]
+        ux, uy, uz = X[b, 0] - X[a, 0], X[b, 1] - X[a, 1], X[b, 2] - X[a, 2]
+        vx, vy, vz = X[c, 0] - X[a, 0], X[c, 1] - X[a, 1], X[c, 2] - X[a, 2]
+        nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        for k in (a, b, c):
+            out[k, 0] += nx
+            out[k, 1] += ny
+            out[k, 2] += nz
+    for k in range(out.shape[0]):
+        n = np.sqrt(out[k, 0] ** 2 + out[k, 1] ** 2 + out[k, 2] ** 2)
+        if n > 0.0:
+            out[k, 0] /= n
+            out[k, 1] /= n
+            out[k, 2] /= n
+
+
+@njit(cache=True)
+def signed_distance(pts, tri, bary, dist, X, tris, vn, out_s, out_n):
+    """Signed distance (m, negative inside) and outward normal of each point from its
+    nearest skin triangle (tri[i] >= 0; closest point by bary). The side is told by the
+    normal interpolated from the vertex normals at the closest point, not the face's: a point
+    whose closest point is on an edge or vertex in a crease (armpit, crotch) would get the
+    wrong side from either face's normal."""
+    for i in range(pts.shape[0]):
+        e = tri[i]
+        if e < 0:
+            out_s[i] = np.inf
+            continue
+        a, b, c = tris[e, 0], tris[e, 1], tris[e, 2]
+        w0, w1, w2 = bary[i, 0], bary[i, 1], bary[i, 2]
+        mx = w0 * vn[a, 0] + w1 * vn[b, 0] + w2 * vn[c, 0]
+        my = w0 * vn[a, 1] + w1 * vn[b, 1] + w2 * vn[c, 1]
+        mz = w0 * vn[a, 2] + w1 * vn[b, 2] + w2 * vn[c, 2]
+        ml = np.sqrt(mx * mx + my * my + mz * mz)
+        if ml > 0.0:
+            mx, my, mz = mx / ml, my / ml, mz / ml
+        d = dist[i]
+        px = w0 * X[a, 0] + w1 * X[b, 0] + w2 * X[c, 0]
+        py = w0 * X[a, 1] + w1 * X[b, 1] + w2 * X[c, 1]
+        pz = w0 * X[a, 2] + w1 * X[b, 2] + w2 * X[c, 2]
+        if d > 1e-12:
+            ux, uy, uz = (pts[i, 0] - px) / d, (pts[i, 1] - py) / d, (pts[i, 2] - pz) / d
+            sign = -1.0 if ux * mx + uy * my + uz * mz < 0.0 else 1.0
+            out_s[i] = sign * d
+            out_n[i, 0], out_n[i, 1], out_n[i, 2] = sign * ux, sign * uy, sign * uz
+        else:
+            out_s[i] = 0.0
+            out_n[i, 0], out_n[i, 1], out_n[i, 2] = mx, my, mz

@@ -1,0 +1,214 @@
+"""Clothing (issue 16): the skinned body surface, the garment builder, the skin contact."""
+import numpy as np
+import pytest
+
+from interplay.errors import ParameterError
+from interplay.geometry import garment as G
+from interplay.geometry.aabb_tree import AABBTree
+from interplay.geometry.anthropometry import body_plan
+from interplay.geometry.body_surface import BodySurface, SurfaceParams, edge_use
+from interplay.geometry.mesh import edges
+from interplay.interactions.skin_contact import SkinContactParams, _Projector
+from interplay.systems.mocap import MocapFigure, clip_path
+from interplay.systems.springmass import SpringNetwork
+
+
+@pytest.fixture(scope="module")
+def surface():
+    return BodySurface(body_plan(), SurfaceParams(spacing=0.025))
+
+
+@pytest.fixture(scope="module")
+def run_clip():
+    path = clip_path("cmu_02_03_run.bvh")
+    if not path.exists():
+        pytest.skip("no motion-capture data (../shared/data)")
+    return MocapFigure("runner", path, ground=0.0)
+
+
+def volume(x, t):
+    return float(np.einsum("ij,ij->i", x[t[:, 0]], np.cross(x[t[:, 1]], x[t[:, 2]])).sum() / 6)
+
+
+# --- the body surface ------------------------------------------------------------------------
+def test_the_skin_is_closed_outward_and_holds_the_body(surface):
+    """Every edge in exactly two triangles, one piece of genus 0 (V - E + F = 2), wound
+    outward (positive volume), holding the body's tissue: its volume times the tissue density
+    within 20% of the plan's mass (the head, hands and feet are not made of capsules)."""
+    x, t = surface.vertices0, surface.triangles
+    assert np.all(edge_use(t) == 2)
+    e, _, _ = edges(t)
+    assert len(x) - len(e) + len(t) == 2
+    mass = sum(s.mass for s in surface.plan)
+    assert abs(volume(x, t) * 1050.0 / mass - 1.0) < 0.2
+
+
+def test_the_skin_bends_at_the_joints_without_cracks(surface, run_clip):
+    """Posed by the run clip, the skin keeps its topology (it is one mesh moved by convex
+    combinations of rigid motions) and no edge grows more than 2.5x its A-pose length at the
+    shoulders, hips and knees (a crack would be a jump in length), sampled every 0.1 s."""
+    skin = BodySurface(run_clip.plan, SurfaceParams(spacing=0.03))
+    e, _, _ = edges(skin.triangles)
+    l0 = np.linalg.norm(skin.vertices0[e[:, 0]] - skin.vertices0[e[:, 1]], axis=1)
+    for t in np.arange(0.0, run_clip.duration, 0.1):
+        run_clip.set_time(t)
+        X = skin.pose(*run_clip.part_poses())
+        ratio = np.linalg.norm(X[e[:, 0]] - X[e[:, 1]], axis=1) / l0
+        assert ratio.max() < 2.5, f"t={t:.1f}: an edge {ratio.max():.2f}x its rest length"
+
+
+@pytest.mark.xfail(strict=True, reason="the clip swings its hands through the hips and the "
+                   "thighs brush: the skinned surface crosses itself there (measured per "
+                   "frame in docs/clothing.md)")
+def test_the_skin_never_crosses_itself_over_the_run_clip(run_clip):
+    skin = BodySurface(run_clip.plan, SurfaceParams(spacing=0.03))
+    tree = AABBTree(skin.vertices0, skin.triangles)
+    for t in np.arange(0.0, run_clip.duration, 0.1):
+        run_clip.set_time(t)
+        tree.refit(skin.pose(*run_clip.part_poses()))
+        assert len(tree.intersections()) == 0, f"t={t:.1f}"
+
+
+# --- garments --------------------------------------------------------------------------------
+def test_the_panels_sew_into_closed_garments_of_the_stated_size(surface):
+    """Welded seams leave only the openings: a tee has its hem, neck and two sleeve ends, a
+    vest its hem, neck and two armholes, pants a waist and two cuffs, a skirt a waist and a
+    hem; every edge belongs to one or two triangles. The tee's chest grows by 2 pi times the
+    ease (a ring ``ease`` farther out all round) within 15% of that growth (the ring is the
+    convex hull of the body's section, which the ease rounds); the pants reach the ankle."""
+    fit = G.Fit(spacing=0.02)
+    cases = {"tee": (G.tee, 4), "vest": (G.vest, 4), "pants": (G.sweatpants, 3),
+             "skirt": (G.skirt, 2)}
+    made = {}
+    for name, (make, openings) in cases.items():
+        g = make(surface, fit)
+        e, counts, _ = edges(g.triangles)
+        assert counts.max() <= 2, name
+        assert len(G.boundary_loops(g.triangles)) == openings, name
+        made[name] = g
+    loose = G.tee(surface, G.Fit(spacing=0.02, ease=0.03)).sizes["chest_girth"]
+    chest = made["tee"].sizes["chest_girth"]
+    growth = 2 * np.pi * (0.03 - fit.ease)
+    assert abs(loose - chest - growth) < 0.15 * growth
+    P = {s.name: k for k, s in enumerate(surface.plan)}
+    ankle = surface.pos0[P["l_foot"], 2]
+    pants = made["pants"]
+    low = pants.vertices[pants.groups["cuff_l"], 2].mean()
+    assert abs(low - (ankle + 0.035)) < 0.02
+    # the mass is the cut area at the fabric's areal density
+    net = G.network(pants)
+    assert net.m.sum() == pytest.approx(pants.area * G.FABRICS["fleece"].density, rel=1e-9)
+
+
+def test_bad_garment_meshes_are_refused_naming_the_element(surface, tmp_path):
+    x = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0, -1, 0]], float) * 0.01
+    t = np.array([[0, 1, 2], [0, 1, 3], [0, 1, 4]])
+    with pytest.raises(ParameterError, match=r"edge \(0, 1\) is shared by 3 triangles"):
+        G.check_garment(G.Garment("bad", x, t, G.FABRICS["cotton_jersey"]))
+    big = x * 20.0
+    with pytest.raises(ParameterError, match=r"edge \(\d+, \d+\) is .* too coarse"):
+        G.check_garment(G.Garment("coarse", big, t[:2], G.FABRICS["cotton_jersey"]),
+                        max_edge=0.05)
+    # a patch through the torso: deeper inside than dressing can fix
+    import trimesh
+    P = {s.name: k for k, s in enumerate(surface.plan)}
+    c = surface.pos0[P["torso"]] + [0.0, 0.0, 0.15]
+    sq = np.array([[-0.01, -0.01, 0], [0.01, -0.01, 0], [0.01, 0.01, 0], [-0.01, 0.01, 0]]) + c
+    path = tmp_path / "through.obj"
+    trimesh.Trimesh(sq, [[0, 1, 2], [0, 2, 3]], process=False).export(path)
+    with pytest.raises(ParameterError, match=r"vertex \d starts .* cm inside the body"):
+        G.load_garment(path, surface=surface)
+
+
+# --- the skin contact --------------------------------------------------------------------------
+def _square(centre, size, n, normal_axis=2):
+    from interplay.geometry.shapes import grid
+    x, t = grid(size, size, n, n)
+    x = x - x.mean(axis=0) + centre
+    return x, t
+
+
+def test_a_cloth_square_at_5_m_per_s_onto_the_thigh_does_not_tunnel(surface):
+    """A 20 cm cotton square falls at 5 m/s onto the front of the A-pose thigh at the runner's
+    step (1/240 s: 2.1 cm a step, less than the reach and the thigh's radius): after 0.1 s no
+    point is inside the skin and no cloth triangle crosses a skin triangle."""
+    P = {s.name: k for k, s in enumerate(surface.plan)}
+    hip = surface.pos0[P["l_thigh"]]
+    top = surface.mesh_distance(hip[None] + [0.3, 0.0, -0.12], reach=1.0)[0][0]
+    # start 5 cm in front of the thigh's front surface, moving back onto it
+    x, t = _square(hip + [0.3 - top + 0.05, 0.0, -0.12], 0.2, 12)
+    x = x[:, [2, 1, 0]] - x[:, [2, 1, 0]].mean(axis=0) + (hip + [0.3 - top + 0.05, 0, -0.12])
+    net = SpringNetwork.from_mesh("square", x, t, 0.2 * 0.2 * 0.16, 300.0, dt=1 / 240,
+                                  integrator="localglobal", mass_damping=0.1)
+    net.v[:] = [-5.0, 0.0, 0.0]
+    h = 1 / 240
+    X, V = surface.vertices0, np.zeros_like(surface.vertices0)
+    proj = _Projector(net, surface.triangles, SkinContactParams(), X)
+    touched = 0
+    for _ in range(24):
+        net.clear_forces()
+        proj.start()
+        net.advance(h)
+        proj.resolve(X, V, h)
+        touched = max(touched, proj.count)
+    s, _ = surface.mesh_distance(net.x)
+    assert s.min() > 0.0
+    assert len(AABBTree(X, surface.triangles).intersections(AABBTree(net.x, net.triangles))) == 0
+    assert touched > 20  # it did land
+
+
+def _slope_skin(theta):
+    """A closed box 1 x 1 x 0.2 m whose top face is tilted by theta about y."""
+    import trimesh
+    box = trimesh.creation.box((1.0, 1.0, 0.2))
+    c, s = np.cos(theta), np.sin(theta)
+    R = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    return np.asarray(box.vertices) @ R.T, np.asarray(box.faces, np.int64), R
+
+
+@pytest.mark.parametrize("theta_deg,mu,sticks", [(20.0, 0.5, True), (35.0, 0.5, False)])
+def test_friction_holds_below_the_cone_and_slides_by_coulomb_above(theta_deg, mu, sticks):
+    """A point resting on a slope of the skin under gravity (symplectic Euler steps of 1 ms,
+    projected after each): at tan(theta) = 0.36 < mu = 0.5 it stays (moves < 0.1 mm in
+    0.5 s); at tan(theta) = 0.70 it slides with g (sin - mu cos) within 3% (the sliding
+    friction uses the normal correction of each step, g cos h)."""
+    theta = np.radians(theta_deg)
+    X, T, R = _slope_skin(theta)
+    top = R @ np.array([0.0, 0.0, 0.1])
+    n = R @ np.array([0.0, 0.0, 1.0])
+    net = SpringNetwork("pt", (top + 0.004 * n)[None], [1e-3],
+                        __import__("interplay.systems.springmass",
+                                   fromlist=["Springs"]).Springs(
+                            np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0),
+                            np.zeros(0), np.zeros(0, bool)), dt=1e-3, integrator="explicit")
+    proj = _Projector(net, T, SkinContactParams(thickness=0.004, friction=mu), X)
+    h, steps = 1e-3, 500
+    x_start = net.x[0].copy()
+    for _ in range(steps):
+        net.clear_forces()
+        proj.start()
+        net.advance(h)
+        proj.resolve(X, np.zeros_like(X), h)
+    moved = np.linalg.norm(net.x[0] - x_start)
+    if sticks:
+        assert moved < 1e-4
+    else:
+        g = 9.81
+        want = 0.5 * g * (np.sin(theta) - mu * np.cos(theta)) * (steps * h) ** 2
+        assert moved == pytest.approx(want, rel=0.03)
+
+
+def test_the_keyframed_run_is_a_clip_the_figure_plays(tmp_path):
+    """Without motion capture the runner plays a keyframed run: a BVH the reader and the
+    retargeting take (metres from centimetres), moving forward at its speed (3.2 m/s within
+    5%: the root's forward channel is speed x t) with its feet near the ground."""
+    from interplay.scenes.runner import keyframed_run
+    path = tmp_path / "run.bvh"
+    keyframed_run(path, duration=1.0)
+    fig = MocapFigure("runner", path, units="cm", skip_tpose=False, ground=0.0)
+    fig.set_time(0.0)
+    x0 = fig.segment_positions()[0].copy()
+    fig.set_time(0.9)
+    moved = np.linalg.norm(fig.segment_positions()[0][:2] - x0[:2])
+    assert moved == pytest.approx(3.2 * 0.9, rel=0.05)
+    assert 0.7 < fig.body.height < 2.5
