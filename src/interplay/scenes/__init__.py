@@ -6,7 +6,7 @@ import importlib
 from ..errors import SceneError
 
 #: the scene modules, loaded on demand (a scene's module imports its systems)
-MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "pond", "puddle",
+MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "mat", "pond", "puddle",
            "stunt_kite", "trampoline")
 
 

@@ -24,7 +24,12 @@ class SceneSpec:
     the moment its figure shows (the ball in the net), the gallery's still; figures: result ->
     {label: value}, the scene's own key figures (the basketball's exit speed) for summaries
     and compare tables; searches: the ``control.search.Search``es ``interplay tune`` can run
-    on it (the first is the default).
+    on it (the first is the default); fit: (spec, params, **build keywords) -> report, a
+    scene's own stand-in fit for ``fit-standin`` instead of matching the velocity at fit_time
+    (the mat's: its curve to the mat's load-deflection; the report's "sets" are the fitted
+    --set lines); debug_ratio: its primary is tuned by hand, so ``compare``'s advisor wants
+    its debug cycle at most 1/debug_ratio of two-way's (analysis/advisor.py; None: the
+    advisor counts work only).
     """
     name: str
     description: str
@@ -40,6 +45,8 @@ class SceneSpec:
     key_time: float | None = None
     figures: Callable | None = field(default=None, compare=False)
     searches: tuple = field(default=(), compare=False)
+    fit: Callable | None = field(default=None, compare=False)
+    debug_ratio: float | None = None
 
     @property
     def default_coupling(self) -> str:
@@ -96,7 +103,7 @@ class SceneSpec:
                              f"{_list([s.name for s in self.searches])}")
 
     def check_fit(self):
-        if self.standin is None or self.fit_time is None:
+        if self.standin is None or (self.fit_time is None and self.fit is None):
             raise SceneError(f"{self.name} has no stand-in that fit-standin can fit"
                              f"{'' if 'hybrid' in self.couplings else ' (no hybrid coupling)'}"
                              "; scenes with one: "
@@ -110,4 +117,5 @@ def _list(items) -> str:
 
 def fittable():
     from . import all_specs
-    return [s for s in all_specs() if s.standin is not None and s.fit_time is not None]
+    return [s for s in all_specs() if s.standin is not None
+            and (s.fit_time is not None or s.fit is not None)]
