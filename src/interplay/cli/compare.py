@@ -47,6 +47,10 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
     advice = first.advice(one_way_stable=one_way_stable, two_way_work=two_way_cost,
                           two_way_wall_s=wall, debug_cycle=debug)
     report = {"scene": spec.name, "modes": rows, "advice": advice}
+    if spec.contrast is not None:
+        report["contrast"] = spec.contrast(results)
+        for label, value in report["contrast"].items():
+            console.print(f"{label}: {_figure(value)}", markup=False)
     path = out / "compare.json"
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(report, indent=2))

@@ -41,20 +41,21 @@ class MatParams:
     contact skin on its top (m) is the contact's; x0 (m): the mat's near edge along x (the
     direction of the vault)."""
     enabled: bool = param(True, doc="false: a rigid floor at the mat's top instead")
-    length: float = param(2.4, "m", gt=0.0, le=20.0)
+    length: float = param(3.0, "m", gt=0.0, le=20.0)
     width: float = param(1.6, "m", gt=0.0, le=20.0)
     thickness: float = param(0.2, "m", gt=0.0, le=2.0)
-    nx: int = param(25, "points", ge=2, le=200, cost="points")
+    nx: int = param(31, "points", ge=2, le=200, cost="points")
     ny: int = param(17, "points", ge=2, le=200, cost="points")
     nz: int = param(4, "points", ge=2, le=20, cost="points")
-    mass: float = param(30.0, "kg", gt=0.0, le=1000.0)
+    mass: float = param(37.5, "kg", gt=0.0, le=1000.0)
     modulus: float = param(6.0e4, "Pa", gt=0.0, le=1e9, doc="foam's compressive modulus")
-    brace: float = param(0.5, "-", ge=0.0, le=10.0, doc="diagonals' share of an edge's k")
+    brace: float = param(1.5, "-", ge=0.0, le=10.0, doc="diagonals' share of an edge's k")
     cover: float = param(2.0e4, "N", ge=0.0, le=1e8, doc="the top cover's stress/strain")
+    top_ratio: float = param(1.0, "-", gt=0.0, le=1e3, doc="top layer's modulus / the foam's")
     stiffness_damping: float = param(1e-4, "s", ge=0.0, le=1.0)
     mass_damping: float = param(20.0, "1/s", ge=0.0, le=1e3)
     dt: float = param(1e-4, "s", gt=0.0, le=0.01)
-    x0: float = param(1.0, "m", ge=-100.0, le=100.0, doc="near edge along x")
+    x0: float = param(1.5, "m", ge=-100.0, le=100.0, doc="near edge along x")
 
     def validated(self) -> "MatParams":
         for name, unit in (("length", "m"), ("width", "m"), ("thickness", "m"),
@@ -178,6 +179,11 @@ def build_mat(p: MatParams) -> Lattice:
     # a brace: the modulus over the cell's mean face, as stiff per length as an inner edge
     face = (dx * dy + dy * dz + dx * dz) / 3.0
     k[~edge] = p.brace * p.modulus * face / rest[~edge]
+    # the top layer of cells is a firmer foam (top_ratio times the modulus): competition
+    # mats put a firm layer over a soft one, and a firm layer spreads a foot's load over the
+    # soft foam as a plate (Mills, Pain & Yeadon 2006 model such a mat in layers)
+    zmin = np.minimum(x[ij[:, 0], 2], x[ij[:, 1], 2])
+    k[zmin >= p.thickness - dz - 1e-9] *= p.top_ratio
     # the cover: a stiff skin over the top face (vinyl over a firmer top foam) that spreads a
     # foot's load over the foam around it, as an area-elastic mat does; k = cover / length
     # on every spring lying in the top face (its edges and face diagonals)

@@ -29,7 +29,8 @@ class SceneSpec:
     (the mat's: its curve to the mat's load-deflection; the report's "sets" are the fitted
     --set lines); debug_ratio: its primary is tuned by hand, so ``compare``'s advisor wants
     its debug cycle at most 1/debug_ratio of two-way's (analysis/advisor.py; None: the
-    advisor counts work only).
+    advisor counts work only); contrast: {mode: Result} -> {label: value}, figures across
+    the couplings for ``compare`` (the mat's: hybrid's centre-of-mass path off two-way's).
     """
     name: str
     description: str
@@ -47,6 +48,7 @@ class SceneSpec:
     searches: tuple = field(default=(), compare=False)
     fit: Callable | None = field(default=None, compare=False)
     debug_ratio: float | None = None
+    contrast: Callable | None = field(default=None, compare=False)
 
     @property
     def default_coupling(self) -> str:

@@ -37,13 +37,13 @@ from ..systems.colliders import StaticBox
 from ..systems.springmass import SpringNetwork, Springs
 from ..systems.static import StaticPlane
 from .contract import SceneSpec
+from .landing_measures import contrast, landing_figures
 from .trampoline import check_explicit
 
 TABLE = (0.6, 0.475)  # m: the vault table's half length (x) and half width (y) (FIG: 1.2 x 0.95)
-FEET = [SEGMENTS.index(s) for s in ("l_foot", "r_foot", "l_toes", "r_toes")]
 SOLES = [SEGMENTS.index(s) for s in ("l_foot", "r_foot")]
 MARGIN = 0.1  # m: her landing must be this far inside the mat's edges
-FIT_LOADS = (0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0)  # body weights: the landing's range of loads
+FIT_LOADS = (0.5, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0)  # body weights: a landing's
 
 
 @dataclass(frozen=True)
@@ -57,8 +57,8 @@ class MatSceneParams:
     vault: VaultParams = VaultParams()
     contact: PartContactParams = PartContactParams(friction=1.0)
     # fitted to MatParams() by `interplay fit-standin mat` (docs/mat.md)
-    standin: BedSpringsParams = BedSpringsParams(linear=38169.7, quadratic=194278.0,
-                                                 cubic=1670260.0,
+    standin: BedSpringsParams = BedSpringsParams(linear=60774.1, quadratic=148032.0,
+                                                 cubic=1146180.0,
                                                  damping=300.0, pocket=0.03,
                                                  friction_damping=2000.0, friction=1.0)
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
@@ -186,7 +186,9 @@ def build(coupling: str = "hybrid", duration: float = 2.2, fps: float = 60.0,
         check_landing(params, flight(params, params.coupling_dt))
     fig = scene.add(gymnast(params.vault, floor=floor_h, air_density=params.air_density))
     scene.primary = fig
-    meta = {"mass": params.vault.mass, "mat_top": top, "mat_enabled": mp.enabled, "footprint": list(mp.footprint())}
+    meta = {"vault": dataclasses.asdict(params.vault), "mat_top": top,
+            "mat_enabled": mp.enabled, "footprint": list(mp.footprint()),
+            "lattice": [mp.nx, mp.ny, mp.nz]}
     if mp.enabled:
         net = scene.add(mat_network(mp, integrator or "explicit", dt))
         # the stand-in's springs begin where the resting mat's top is, plus the skin
@@ -198,94 +200,10 @@ def build(coupling: str = "hybrid", duration: float = 2.2, fps: float = 60.0,
     return scene
 
 
-# --- what the run shows -----------------------------------------------------------------------
-def _touchdown(t, low, level):
-    """Index of the first frame her lowest foot point is within 2 cm of ``level``."""
-    hit = np.flatnonzero(low <= level + 0.02)
-    return int(hit[0]) if len(hit) else None
-
-
-def landing_figures(result) -> dict:
-    """The landing's key figures: peak vertical force on her (N, and in body weights) and its
-    loading rate (N/s, rise from 10% to 90% of the first peak... here the largest rise over
-    5 ms), from the interaction's force log (the mat) or MuJoCo's floor (recorded as her
-    momentum change); the mat's deepest depression (m); how far the replayed feet went
-    below the mat's top (m, one-way replay); whether she stuck the landing: upright and
-    still over her feet within 1 s of touch-down, without a step (feet moved < 5 cm)."""
-    fr = result.frames.get("gymnast")
-    if fr is None:
-        return {}
-    meta = result.meta
-    top = meta["mat_top"]
-    t, com, seg = fr["t"], fr["com"], fr["segment_positions"]
-    out = {}
-    force = vertical_force(result)
-    if force is not None:
-        tf, fz = force
-        mass = 64.38 if "mass" not in meta else meta["mass"]
-        k = int(np.argmax(fz))
-        out["peak vertical force (N)"] = float(fz[k])
-        out["peak vertical force (body weights)"] = float(fz[k] / (mass * 9.81))
-        out["time of peak force (s)"] = float(tf[k])
-        w = max(1, int(round(0.005 / (tf[1] - tf[0]))))
-        rate = (fz[w:] - fz[:-w]) / (tf[w:] - tf[:-w])
-        out["peak loading rate (N/s)"] = float(rate[:k + 1].max()) if k >= w else None
-    net = result.frames.get("mat")
-    if net is not None:
-        out["mat depression (m)"] = float(top - net["points"][:, :, 2].min())
-    stick = stuck(t, com, seg, fr)
-    out.update(stick)
-    return out
-
-
-def vertical_force(result):
-    """(t s, vertical force N on her) from the gymnast-mat log (two-way and the one-way
-    replay: the full contact; hybrid: the stand-in her pass felt), or None without a mat."""
-    log = result.logs.get("gymnast-mat")
-    if log is None:
-        return None
-    if result.coupling == "hybrid" and log.standin is not None:
-        log = log.standin
-    return log.t, log.force[:, 2]
-
-
-def stuck(t, com, seg, fr) -> dict:
-    """Touch-down (s: the first frame a foot's contact wrench is non-zero or it reaches its
-    lowest), then: upright (pelvis tilt rad), the centre of mass's speed (m/s) over the last
-    0.2 s of the first second after touch-down, its lead over the feet (m), and how far the
-    feet moved (m) from 0.15 s after touch-down (a step or a slide)."""
-    wr = fr["segment_wrenches"][:, FEET, :3]
-    touching = np.flatnonzero(np.abs(wr).sum(axis=(1, 2)) > 0)
-    low = seg[:, SOLES, 2].min(axis=1)
-    k0 = int(touching[0]) if len(touching) else int(np.argmin(low[: len(low) // 2 + 1]))
-    td = float(t[k0])
-    out = {"touch-down (s)": td}
-    after = t - td
-    settle = np.flatnonzero(after >= 0.15)
-    if not len(settle):
-        return out
-    feet = seg[:, SOLES, :2]
-    moved = float(np.abs(feet[settle] - feet[settle[0]]).max())
-    win = np.flatnonzero((after >= 0.8) & (after <= 1.0))
-    out["feet moved after touch-down (m)"] = moved
-    if len(win) < 2:
-        return out
-    v = np.gradient(com, t, axis=0)
-    speed = float(np.hypot(v[win, 0], v[win, 1]).max())
-    lead = float(np.abs(com[win, 0] - feet[win].mean(axis=1)[:, 0]).max())
-    q = fr["segment_orientations"][win, 0]  # the pelvis (w, x, y, z)
-    upz = 1.0 - 2.0 * (q[:, 1] ** 2 + q[:, 2] ** 2)
-    tilt = float(np.arccos(np.clip(upz.min(), -1.0, 1.0)))
-    out.update({"speed 1 s after touch-down (m/s)": speed,
-                "centre of mass over the feet (m)": lead, "pelvis tilt (rad)": tilt,
-                "stuck": bool(speed < 0.15 and lead < 0.12 and tilt < 0.35 and moved < 0.05)})
-    return out
-
-
 SPEC = SceneSpec(
     "mat", "a gymnast lands a vault on a spring-mass floor mat; vertical springs stand in for "
            "the mat, then her motion drives it (hybrid)", build, MatSceneParams,
     couplings=("hybrid", "two-way", "one-way"), duration=2.2, fps=60.0,
     integrators=("explicit", "implicit"), standin="standin", fit=fit, figures=landing_figures,
-    debug_ratio=5.0,
-    camera=Camera((2.0, -6.5, 1.8), (2.3, 0.0, 0.8), 45.0), key_time=0.85)
+    debug_ratio=5.0, contrast=contrast,
+    camera=Camera((1.9, -6.8, 2.0), (1.9, 0.0, 1.0), 45.0), key_time=0.83)
