@@ -123,7 +123,7 @@ def test_two_way_forces_are_equal_and_opposite_every_step():
             assert np.allclose(fig.segment_wrenches()[:, :3].sum(axis=0), given / H,
                                atol=1e-9 * scale / H)
         fig.advance(H)
-    assert touched > 100
+    assert touched > 50  # she touches down at ~0.8 s: the contact acted on 50+ steps
 
 
 def test_a_vault_that_misses_the_mat_is_refused_in_one_line(capsys):

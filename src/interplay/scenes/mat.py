@@ -90,8 +90,8 @@ def pressed_points(net, half: float = FEET_HALF) -> np.ndarray:
     return net.top[near]
 
 
-def press(net, load: float, half: float = FEET_HALF, seconds: float = 0.6,
-          damping: float = 100.0, h: float = 5e-3) -> float:
+def press(net, load: float, half: float = FEET_HALF, seconds: float = 0.4,
+          damping: float = 100.0, h: float = 1e-2) -> float:
     """Settle the mat ``net`` on a rigid floor (its bottom layer held) under a downward load
     (N) spread evenly over the top points within ``half`` (m) of the centre (two feet side by
     side), by heavily damped backward-Euler steps; returns the depression (m) of the top's
