@@ -59,7 +59,7 @@ def same_result(a, b):
 CASES = {"basketball": ("hybrid", 0.3), "bungee": ("two-way", 0.4), "flags": ("one-way", 0.2),
          "leaves": ("one-way", 0.2), "pond": ("two-way", 0.2), "puddle": ("one-way", 0.2),
          "diver": ("hybrid", 0.3), "kites": ("two-way", 0.2), "stunt_kite": ("two-way", 0.2),
-         "trampoline": ("two-way", 0.6), "mat": ("hybrid", 0.3)}
+         "trampoline": ("two-way", 0.6), "owl_creek": ("two-way", 0.3), "mat": ("hybrid", 0.3)}
 
 
 @pytest.mark.parametrize("name", MODULES)

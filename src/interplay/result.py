@@ -126,16 +126,21 @@ class Result:
         """The advisor's verdict for the scene's main interaction; the verdict depends on
         counts only, unless debug_cycle gives the measured times of a hand-tuned primary
         (analysis/advisor.py); the wall time of the two-way run is reported beside it."""
-        out = self._advice(one_way_stable, two_way_work, debug_cycle)
+        out = self._advice(one_way_stable, two_way_work, debug_cycle=debug_cycle)
         if two_way_wall_s is None and self.coupling == "two-way":
             two_way_wall_s = self.total_s - self.compile_s
         if two_way_wall_s is not None:
             out["two_way_wall_s"] = float(two_way_wall_s)
         return out
 
-    def _advice(self, one_way_stable, two_way_cost_s, debug_cycle=None) -> dict:
-        """The advisor's verdict for the scene's main interaction."""
-        it = self.main_interaction
+    def advice_for(self, it: dict) -> dict:
+        """The advisor's verdict for any interaction (its ``describe()``) from this run."""
+        return self._advice(None, None, it)
+
+    def _advice(self, one_way_stable, two_way_cost_s, it=None, debug_cycle=None) -> dict:
+        """The advisor's verdict for the interaction described by ``it`` (default: the
+        scene's main interaction); debug_cycle: analysis/advisor.py ``advise``."""
+        it = self.main_interaction if it is None else it
         if it is None:
             return {"mode": None, "reasons": ["no interaction acts on a moving system"]}
         if one_way_stable is None and it["mode"] != "two-way":
@@ -149,6 +154,8 @@ class Result:
         return {"scene": self.scene, "coupling": self.coupling, "duration_s": self.duration,
                 "fps": self.fps, "systems": self.systems, "timings": self.timings(),
                 "interactions": self.interaction_stats(), "advice": self.advice(**advice_kw),
+                "interaction_advice": {it["name"]: self.advice_for(it)
+                                       for it in self.interactions},
                 "diagnostics": self.diagnostics, "primary_checkpoints": self.checkpoints(),
                 "warnings": list(self.warnings)}
 

@@ -102,7 +102,7 @@ class Scene:
         check_budget(estimate(passes, self.duration, self.fps, self.coupling_dt), self.name,
                      force)
         logs = {it.name: ForceLog(it.name, it.primary.name, it.secondary.name, it.mode,
-                                  it.primary.mass) for it in self.interactions}
+                                  it.primary.mass, it.period_from) for it in self.interactions}
         runner = Runner(self.systems, self.interactions, passes, self.duration, self.fps,
                         self.coupling_dt, logs, progress, refine_unstable,
                         checkpointer=checkpointer)

@@ -302,11 +302,12 @@ def cmd_run(args, console):
             (out / C.FILE).unlink(missing_ok=True)
             raise
         result.warnings[:0] = args.notes
-        paths = write_outputs(result, out, options, scene_summary(spec, result), run_id,
-                              _request(args), locked=True)
+        summary = scene_summary(spec, result)
+        paths = write_outputs(result, out, options, summary, run_id, _request(args),
+                              locked=True)
         (out / C.FILE).unlink(missing_ok=True)
     from .text import print_run
-    print_run(console, result)
+    print_run(console, result, summary.get("figures"))
     for p in paths:
         console.print(f"wrote {p}", markup=False, soft_wrap=True)
 

@@ -5,6 +5,7 @@ import json
 from pathlib import Path
 
 from ..io.atomic import atomic_path
+from ..outputs.report import figure_text
 from .text import mode_row
 
 
@@ -50,7 +51,7 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
     if spec.contrast is not None:
         report["contrast"] = spec.contrast(results)
         for label, value in report["contrast"].items():
-            console.print(f"{label}: {_figure(value)}", markup=False)
+            console.print(f"{label}: {figure_text(value)}", markup=False)
     path = out / "compare.json"
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(report, indent=2))
@@ -64,18 +65,6 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
     return report
 
 
-def _figure(value) -> str:
-    """A key figure as table text: numbers to 3 places, lists item by item (a scene's
-    figures may also hold counts, names, nested lists and None for "not measured")."""
-    if value is None:
-        return "-"
-    if isinstance(value, (list, tuple)):
-        return ", ".join(f"{v:.2f}" if isinstance(v, float) else _figure(v) for v in value)
-    if isinstance(value, float):
-        return f"{value:.3f}"
-    return str(value)
-
-
 def _print_table(console, rows, advice):
     from rich.table import Table
     table = Table(title="coupling modes side by side")
@@ -87,7 +76,7 @@ def _print_table(console, rows, advice):
 
     labels = list(dict.fromkeys(k for r in rows.values() for k in r["figures"]))
     for label in labels:
-        line(label, lambda r, k=label: _figure(r["figures"][k]) if k in r["figures"] else "-")
+        line(label, lambda r, k=label: figure_text(r["figures"][k]) if k in r["figures"] else "-")
     line("max secondary strain", lambda r: f"{100 * r['max_strain']:.1f}%"
          if r["max_strain"] is not None else "-")
     line("force min/max/mean (N)", lambda r: "{min:.1f}/{max:.1f}/{mean:.1f}".format(**r["force_N"]))

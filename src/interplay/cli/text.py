@@ -14,7 +14,9 @@ def mode_row(result, figures: dict | None = None) -> dict:
             "warnings": list(result.warnings), "figures": dict(figures or {})}
 
 
-def print_run(console, result):
+def print_run(console, result, figures: dict | None = None):
+    """The run in a few lines: timings, Table I per interaction, the advice, the scene's own
+    figures (``figures``: label -> value), the warnings."""
     from rich.table import Table
     t = result.timings()
     console.print(f"[bold]{result.scene}[/bold] ({result.coupling}): "
@@ -33,5 +35,14 @@ def print_run(console, result):
     console.print(table)
     adv = result.advice()
     console.print(f"advice: [bold]{adv['mode']}[/bold] - " + "; ".join(adv["reasons"]))
+    # the other interactions on a moving primary (a figure's vest beside its noose)
+    for it in result.interactions:
+        if it["name"] != result.main and it["primary_role"] == "dynamic":
+            other = result.advice_for(it)
+            console.print(f"advice for {it['name']}: [bold]{other['mode']}[/bold] - "
+                          + "; ".join(other["reasons"]))
+    for label, value in (figures or {}).items():
+        shown = f"{value:.4g}" if isinstance(value, float) else value
+        console.print(f"{label}: {shown}", markup=False, soft_wrap=True)
     for w in result.warnings:
         console.print(f"[yellow]warning:[/yellow] {w}")

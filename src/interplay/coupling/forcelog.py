@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+GAP = 0.05  # s: an inactive spell shorter than this does not split a period of contact
+
 
 class ForceLog:
     """Per coupling step: time (s), force (N) and torque (N m) on the primary, contact flag,
@@ -17,9 +19,10 @@ class ForceLog:
     logs what its stand-in applied in the primary's pass (``standin``).
     """
 
-    def __init__(self, name, primary, secondary, mode, primary_mass):
+    def __init__(self, name, primary, secondary, mode, primary_mass, period_from=0.0):
         self.name, self.primary, self.secondary, self.mode = name, primary, secondary, mode
         self.primary_mass = float(primary_mass)
+        self.period_from = float(period_from)  # s: see Interaction.period_from
         self.t = np.zeros(0)
         self.force = np.zeros((0, 3))
         self.torque = np.zeros((0, 3))
@@ -55,9 +58,10 @@ class ForceLog:
     def magnitude(self) -> np.ndarray:
         return np.linalg.norm(self.force, axis=1)
 
-    def episodes(self, gap: float = 0.05) -> list[tuple[float, float]]:
+    def episodes(self, gap: float = None) -> list[tuple[float, float]]:
         """Periods of contact (start, end) in s; inactive spells shorter than ``gap`` s (a cord
         flicking off the ball for a moment) do not split a period."""
+        gap = GAP if gap is None else gap
         idx = np.flatnonzero(self.active)
         if len(idx) == 0:
             return []
@@ -68,6 +72,14 @@ class ForceLog:
         return [(float(t[a]), float(t[b])) for a, b in zip(starts, ends)]
 
     def contact_period(self) -> tuple[float, float] | None:
-        """The first period of contact (s), the one Table I reports, or None if never."""
+        """The period of contact Table I reports, or None if never: the first; with
+        ``period_from`` the first that starts at or after it and lasts at least GAP (the knocks
+        of a slack noose falling with him are not its work), else the one going on then, from
+        then on."""
         eps = self.episodes()
-        return eps[0] if eps else None
+        t0 = self.period_from
+        later = [e for e in eps if e[0] >= t0 and (t0 <= 0.0 or e[1] - e[0] >= GAP)]
+        if later:
+            return later[0]
+        during = [(t0, e[1]) for e in eps if e[1] >= t0]
+        return during[0] if during else None

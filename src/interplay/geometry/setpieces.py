@@ -128,3 +128,31 @@ def ground_around(lo, hi, height: float, size: float, name: str = "ground",
             a, b, c, d = 4 * j + i, 4 * j + i + 1, 4 * (j + 1) + i + 1, 4 * (j + 1) + i
             tris += [(a, b, c), (a, c, d)]
     return Piece(name, v, np.array(tris, np.int64), color, material)
+
+
+def trestle(deck: float, edge: float, arm, span: float = 24.0, width: float = 2.6) -> list:
+    """A timber railroad bridge (the short's, after Bierce): ties on two stringers along y at
+    height deck (m), the deck's side at x = edge, rails on the ties, timber bents down to the
+    creek bed (z = -1) every 6 m, and the hanging frame: a post at the side, braced, with a
+    cross-timber out to ``arm`` (m), the point the rope hangs from."""
+    a = np.asarray(arm, float)
+    x0 = edge - width
+    ties = merge(*[box([x0 - 0.3, y - 0.1, deck - 0.15], [edge, y + 0.1, deck])
+                   for y in np.arange(-span / 2, span / 2 + 1e-9, 0.55)])
+    stringers = merge(*[box([x, -span / 2, deck - 0.55], [x + 0.35, span / 2, deck - 0.15])
+                        for x in (x0 + 0.2, edge - 0.55)])
+    rails = merge(*[box([x - 0.04, -span / 2, deck], [x + 0.04, span / 2, deck + 0.14])
+                    for x in (x0 + 0.55, edge - 0.9)])
+    bents = merge(*[rod([x, y, -1.0], [x, y, deck - 0.55], 0.15)
+                    for y in np.arange(-span / 2 + 3.0, span / 2, 6.0)
+                    for x in (x0 + 0.35, edge - 0.4)])
+    top = a[2] + 0.12
+    post = edge - 0.25
+    frame = merge(rod([post, 0.0, deck], [post, 0.0, top + 0.1], 0.11),
+                  box([post - 0.1, -0.1, a[2] + 0.02], [a[0] + 0.2, 0.1, a[2] + 0.22]),
+                  rod([post, 0.0, top - 0.9], [post + 0.75, 0.0, a[2] + 0.05], 0.06))
+    return [Piece("ties", *ties, (0.30, 0.22, 0.15), "wood"),
+            Piece("stringers", *stringers, (0.26, 0.19, 0.13), "wood"),
+            Piece("rails", *rails, (0.35, 0.33, 0.32), "metal"),
+            Piece("bents", *bents, (0.28, 0.21, 0.14), "wood"),
+            Piece("hanging-frame", *frame, (0.36, 0.27, 0.18), "wood")]

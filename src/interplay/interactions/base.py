@@ -35,9 +35,13 @@ class Interaction(ABC):
     """Base class: a named force exchange between ``primary`` and ``secondary``.
 
     two_way_supported: False for interactions whose two-way form is not implemented (the
-    advisor then looks for a stand-in)."""
+    advisor then looks for a stand-in). period_from (s): Table I reports the first period of
+    contact that starts at or after it (0: the very first); a scene sets it where light
+    contact before its event is not what the row is about (the noose lying on the shoulders
+    before the drop)."""
 
     two_way_supported = True
+    period_from = 0.0
 
     def __init__(self, name: str, primary, secondary, mode: str = "two-way",
                  standin: StandIn | None = None):

@@ -4,7 +4,9 @@ contact law, per kilogram of point mass: ``kernels.contact.points_on_plane``).
 Every point below the plane (plus a thickness) is pushed up by a spring-damper scaled by its
 own mass (so a 10 mg leaf point and a 10 g cloth point sink equally: sag = g / stiffness) and
 held by friction mu f_n against its sliding velocity, regularized below ``eps`` so a resting
-point does not chatter. The forces carry their Jacobians for implicit networks.
+point does not chatter. The forces carry their Jacobians for implicit networks. A point that
+would pass the plane within the coming coupling step is stopped on it (a speculative contact:
+the penalty alone would let it sink up to its speed times the step).
 """
 from __future__ import annotations
 
@@ -50,10 +52,15 @@ class GroundContact(Interaction):
         self.level = height + require_nonnegative(name, "thickness", params.thickness, "m")
         self._law = np.array([0.0, k, c, mu, eps, 0.0])
         self._out = point_forces(len(self.body.x))
+        self._h = 0.0
+
+    def prepare(self, h, dts=None):
+        self._h = h  # the step a speculative contact looks ahead over
 
     def exchange(self, to_primary, to_secondary):
         o = self._out
-        k = points_on_plane(self.body.points, self.level, self._law, o, self.body.jacobians)
+        k = points_on_plane(self.body.points, self.level, self._law, self._h, o,
+                            self.body.jacobians)
         if k == 0:
             return np.zeros(3), np.zeros(3), False
         if to_secondary:

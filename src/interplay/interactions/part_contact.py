@@ -79,10 +79,13 @@ def _edges(triangles) -> np.ndarray:
 class PartContact(Interaction):
     """Rigid parts (primary: any system seen as BodiesView with primitives) against a spring
     network's elements (secondary: a PointsView). elements (s,2): point pairs to collide
-    ((p, p) for points); default the edges of its triangles, else its springs."""
+    ((p, p) for points); default the edges of its triangles, else its springs. extra:
+    ((part name, Primitive), ...) more primitives that parts have for this contact beside their
+    own (a figure's neck, which its sphere of a head leaves out, for a noose round it); each
+    pushes on its part."""
 
     def __init__(self, name, bodies, network, params: PartContactParams = PartContactParams(),
-                 mode="two-way", standin=None, elements=None):
+                 mode="two-way", standin=None, elements=None, extra=()):
         super().__init__(name, bodies, network, mode, standin)
         self.p = params.validated(name)
         view, net = bodies.contact_view(), network.contact_view()
@@ -92,7 +95,15 @@ class PartContact(Interaction):
         if net is None or net.kind != "points":
             raise SceneError(f"interaction {name}: {network.name} is not a spring-mass "
                              "network; use MeshContact for other surfaces")
-        missing = [nm for nm, pr in zip(view.names, view.primitives) if pr is None
+        unknown = [nm for nm, _ in extra if nm not in view.names]
+        if unknown:
+            raise SceneError(f"interaction {name}: {bodies.name} has no parts "
+                             f"{', '.join(unknown)} for the extra primitives")
+        # one row of the kernels' bundle per primitive: the parts' own, then the extra ones
+        self.owner = np.r_[np.arange(view.count), [view.names.index(nm) for nm, _ in extra]]
+        self.owner = self.owner.astype(np.int64)
+        self.primitives = list(view.primitives) + [pr for _, pr in extra]
+        missing = [view.names[o] for o, pr in zip(self.owner, self.primitives) if pr is None
                    or pr.kind not in PC.KINDS]
         if missing:
             raise SceneError(f"interaction {name}: parts {', '.join(missing)} of "
@@ -106,23 +117,26 @@ class PartContact(Interaction):
             raise ParameterError(f"interaction {name}: elements reference points outside "
                                  f"0..{len(net.x) - 1} of {network.name}")
         self.parts = self._parts(elems)
-        self._out = point_forces(2 * self.view.count * len(elems))
-        self._touches = PC.touches(self.view.count * len(elems), self.view.count, len(net.x))
-        self._wrenches = np.zeros((self.view.count, 6))
+        rows = len(self.owner)
+        self._out = point_forces(2 * rows * len(elems))
+        self._touches = PC.touches(rows * len(elems), rows, len(net.x))
+        self._wrenches = np.zeros((rows, 6))
         self._h = 0.0
         self.n_contacts = 0
+        self.deepest = 0.0  # m: the deepest any element went into a part's skin, over the run
 
     def _parts(self, elems) -> PC.Parts:
         """The kernels' bundle: each primitive relative to its part's centre of mass (fixed in
         the part's frame, so computed once from the current pose)."""
-        v = self.view
-        k = v.count
+        v, own = self.view, self.owner
+        k = len(own)
         origin, R = v.poses()
         com = v.centres()
         kind, p, q, size, reach = (np.zeros(k, np.int64), np.zeros((k, 3)), np.zeros((k, 3)),
                                    np.zeros((k, 3)), np.zeros(k))
-        for j, pr in enumerate(v.primitives):
-            off = R[j].T @ (com[j] - origin[j])  # the centre of mass in the part's frame
+        for j, pr in enumerate(self.primitives):
+            o = own[j]
+            off = R[o].T @ (com[o] - origin[o])  # the centre of mass in the part's frame
             kind[j] = PC.KINDS[pr.kind]
             if pr.kind == "capsule":
                 p[j], q[j] = np.asarray(pr.a) - off, np.asarray(pr.b) - off
@@ -137,7 +151,8 @@ class PartContact(Interaction):
         law = np.tile(self.p.law(), (k, 1))
         return PC.Parts(kind, p, q, size, reach, np.zeros((k, 3)), np.zeros((k, 3, 3)),
                         np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
-                        np.asarray(v.masses, float).copy(), law, float(self.p.contact_steps),
+                        np.asarray(v.masses, float)[own].copy(), law,
+                        float(self.p.contact_steps),
                         elems, np.zeros(k + 1, np.int64), np.zeros(k * len(elems), np.int64),
                         np.zeros((k, 7)), np.zeros(1), np.zeros(3))
 
@@ -145,23 +160,27 @@ class PartContact(Interaction):
         self._h = h
 
     def capture(self) -> dict:
-        """The stand-in's memory (the rigid-parts contact itself keeps none between steps)."""
+        """The stand-in's memory and the deepest penetration so far (the rigid-parts contact
+        itself keeps no state between steps)."""
         cap = getattr(self.standin, "capture", None)
-        return {f"standin_{k}": v for k, v in cap().items()} if cap else {}
+        out = {f"standin_{k}": v for k, v in cap().items()} if cap else {}
+        out["deepest"] = np.array(self.deepest)
+        return out
 
     def restore(self, snap: dict):
+        self.deepest = float(snap["deepest"])
         if self.standin is not None and hasattr(self.standin, "restore"):
             self.standin.restore({k[8:]: v for k, v in snap.items() if k.startswith("standin_")})
 
     def _motion(self):
         """Copy the parts' state now into the bundle."""
-        P, v = self.parts, self.view
+        P, v, own = self.parts, self.view, self.owner
         _, R = v.poses()
-        P.rotations[:] = R
-        P.centres[:] = v.centres()
+        P.rotations[:] = R[own]
+        P.centres[:] = v.centres()[own]
         lin, ang = v.velocities()
-        P.velocities[:], P.spins[:] = lin, ang
-        P.accels[:] = v.free_accelerations()
+        P.velocities[:], P.spins[:] = lin[own], ang[own]
+        P.accels[:] = v.free_accelerations()[own]
 
     def exchange(self, to_primary, to_secondary):
         self._motion()
@@ -196,14 +215,15 @@ class PartContact(Interaction):
         """The step's mean force and torque on each part (impulse / h), applied at its centre
         of mass; returns their sum and torque about the system's centre of mass."""
         P, h = self.parts, self._h
+        self._measure_depth()
         touched = np.flatnonzero(P.impulses[:, 6] > 0.0)
         self.n_contacts = len(touched)
         f = P.impulses[touched, :3] / h
         tau = P.impulses[touched, 3:6] / h
         if to_primary:
             for j, fj, tj in zip(touched, f, tau):
-                self.view.apply(int(j), fj, tj)
-            self.view.touched(touched)
+                self.view.apply(int(self.owner[j]), fj, tj)
+            self.view.touched(np.unique(self.owner[touched]))
         total = f.sum(axis=0)
         if not len(touched):
             return np.zeros(3), np.zeros(3), False
@@ -211,6 +231,20 @@ class PartContact(Interaction):
         torque = (tau + np.cross(arm, f)).sum(axis=0)
         return total, torque, True, float(P.peak[0])
 
+    def _measure_depth(self):
+        """The deepest penetration of the contact skin at the end of the step: the network's
+        new points against the parts' predicted poses (what the law let through)."""
+        tc = self._touches
+        cnt = PC.find_touches(self.parts, self._h, self.net.x, tc)
+        if cnt:
+            self.deepest = max(self.deepest, float(tc.pen[:cnt].max()))
+        tc.share[:] = 0.0
+
+    def describe(self) -> dict:
+        return dict(super().describe(), deepest_m=self.deepest)
+
     def segment_forces(self) -> np.ndarray:
         """(k,3) the last step's mean force (N) on each part."""
-        return self.parts.impulses[:, :3] / self._h
+        out = np.zeros((self.view.count, 3))
+        np.add.at(out, self.owner, self.parts.impulses[:, :3] / self._h)
+        return out

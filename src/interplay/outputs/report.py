@@ -59,13 +59,17 @@ def _table(head, rows, classes=None) -> str:
     return "".join(out)
 
 
-def _figure(value) -> str:
-    """A scene's key figure as shown: a number to 3 places, a vector to 2."""
+def figure_text(value) -> str:
+    """A scene's key figure as table text: numbers to 3 places, lists item by item (figures
+    may also hold counts, names, verdicts in words, nested lists and None for "not
+    measured")."""
     if value is None:
         return "-"
     if isinstance(value, (list, tuple)):
-        return ", ".join(f"{v:.2f}" for v in value)
-    return f"{value:.3f}"
+        return ", ".join(f"{v:.2f}" if isinstance(v, float) else figure_text(v) for v in value)
+    if isinstance(value, float):
+        return f"{value:.3f}"
+    return str(value)
 
 
 def _mmm(d, nd) -> str:
@@ -276,7 +280,7 @@ def write_compare_report(runs: dict, out_dir, rows: dict, advice: dict, video=No
     line = lambda label, fn: [_e(label), *(fn(rows[m]) for m in modes)]  # noqa: E731
     labels = list(dict.fromkeys(k for r in rows.values() for k in r.get("figures", {})))
     table = _table(["", *modes], [
-        *(line(label, lambda r, k=label: _figure(r.get("figures", {}).get(k)))
+        *(line(label, lambda r, k=label: figure_text(r.get("figures", {}).get(k)))
           for label in labels),
         line("contact (s)", lambda r: "{:.3f}-{:.3f}".format(*r["contact_s"])
              if r.get("contact_s") else "none"),

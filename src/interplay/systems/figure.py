@@ -24,7 +24,8 @@ from ..params import param
 from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, joint_names,
                                       segment_mesh, segment_primitive)
 from .base import System, substeps
-from .figure_model import AirDrag, EnvironmentParams, build_model, geom_extents, joint_group
+from .figure_model import (FIGURE_GROUP, WORLD_GROUP, AirDrag, EnvironmentParams, build_model,
+                           geom_extents, joint_group)
 from .shape import figure_shape
 from .views import BodiesView, RigidParts
 
@@ -169,6 +170,7 @@ class Figure(System, RigidParts):
         self._extent, self._round = geom_extents(m, self.seg_geom)
         self._twist = np.zeros(6)
         self.color = None
+        self._platform = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "platform")
         self._view = BodiesView(self, SEGMENTS, self.segment_meshes(),
                                 [segment_primitive(s.shape) for s in self.plan],
                                 m.body_mass[self.seg_body], movable=True)
@@ -357,12 +359,21 @@ class Figure(System, RigidParts):
         m, d, mj = self.model, self.data, self._mj
         if m.opt.timestep != sub:
             m.opt.timestep = sub
+        opens = self.params.environment.opens
         done = 0
         while done < n:
             t = self.time + done * sub
             if t >= self._next_control - 1e-9 * sub:
                 self._control(t)
             k = min(n - done, max(1, math.ceil((self._next_control - t) / sub - 1e-9)))
+            if opens is not None and self._platform >= 0:
+                # the platform is there until it opens, gone from the first substep at or
+                # after; the model keeps no state of its own: this follows from the time
+                gone = t >= opens - 1e-9 * sub
+                m.geom_contype[self._platform] = 0 if gone else WORLD_GROUP
+                m.geom_conaffinity[self._platform] = 0 if gone else FIGURE_GROUP
+                if not gone:
+                    k = min(k, max(1, math.ceil((opens - t) / sub - 1e-9)))
             mj.mj_step(m, d, nstep=k)
             done += k
 

@@ -27,11 +27,15 @@ FIGURE_GROUP, WORLD_GROUP = 2, 1  # contype/conaffinity bits: figure-world only,
 class EnvironmentParams:
     """What the figure stands on. floor: height (m) of a ground plane, None for none; platform:
     (x_min, x_max, y_min, y_max, top) m of a static deck whose top face is at z = top, () for
-    none; friction: Coulomb coefficient of the feet on them (-); air_density (kg/m^3): 0 for
-    none, else quadratic drag on each segment's equivalent inertia box (``AirDrag``; air 1.2)."""
+    none; opens (s): the time the platform drops away from under the figure (a gallows' plank
+    or trapdoor: its free end falls faster than she can, so the support is simply gone), None
+    for never; friction: Coulomb coefficient of the feet on them (-); air_density (kg/m^3): 0
+    for none, else quadratic drag on each segment's equivalent inertia box (``AirDrag``; air
+    1.2)."""
     floor: float | None = param(0.0, "m", ge=-1e4, le=1e4, doc="ground height, none: no ground")
     platform: tuple = param((), "m", ge=-1e4, le=1e4, length=(0, 5),
                             doc="x_min, x_max, y_min, y_max, top of a deck, or empty")
+    opens: float | None = param(None, "s", ge=0.0, le=1e5, doc="the platform drops away then")
     friction: float = param(1.0, "-", ge=0.0, le=10.0)
     air_density: float = param(0.0, "kg/m^3", ge=0.0, le=100.0)
 
