@@ -5,7 +5,7 @@ Each mode runs the scene (drapes left out: they cost the same in every mode) for
 simulated seconds: the noose two-way (the default: the alien and the rope in lock step, the
 rope's 10 substeps per 1 ms coupling step carrying the sub-cycled contact) and one-way (the
 alien alone, then the rope driven by his recorded motion: the paper's failure, timed for
-what it would save); and the vest one-way (default) and two-way where the scene has one.
+what it would save).
 Per mode: the primary debug-cycle time (the passes up to the alien's), the total, simulated
 seconds per wall second, and the ratio to the two-way noose timed in the same run. Medians of
 --repeats runs after an untimed warm-up that compiles the kernels.
@@ -18,17 +18,14 @@ from common import machine, parse_args, stats, write_json  # noqa: I001 (pins th
 
 import statistics  # noqa: E402
 import time  # noqa: E402
-from dataclasses import fields, replace  # noqa: E402
+from dataclasses import replace  # noqa: E402
 
 from interplay.scenes import owl_creek as OC  # noqa: E402
 
 
 def modes() -> dict:
     """label -> (noose coupling, changes to the scene's parameters)."""
-    out = {"noose two-way": ("two-way", {}), "noose one-way": ("one-way", {})}
-    if "vest" in {f.name for f in fields(OC.OwlCreekParams)}:
-        out["vest two-way"] = ("two-way", {"vest": ("coupling", "two-way")})
-    return out
+    return {"noose two-way": ("two-way", {}), "noose one-way": ("one-way", {})}
 
 
 def _params(changes: dict) -> OC.OwlCreekParams:

@@ -121,10 +121,12 @@ class Result:
         count, the same on any machine."""
         return float(sum(p.get("work", 0.0) for p in self.passes))
 
-    def advice(self, one_way_stable=None, two_way_work=None, two_way_wall_s=None) -> dict:
+    def advice(self, one_way_stable=None, two_way_work=None, two_way_wall_s=None,
+               debug_cycle=None) -> dict:
         """The advisor's verdict for the scene's main interaction; the verdict depends on
-        counts only; the wall time of the two-way run is reported beside it."""
-        out = self._advice(one_way_stable, two_way_work)
+        counts only, unless debug_cycle gives the measured times of a hand-tuned primary
+        (analysis/advisor.py); the wall time of the two-way run is reported beside it."""
+        out = self._advice(one_way_stable, two_way_work, debug_cycle=debug_cycle)
         if two_way_wall_s is None and self.coupling == "two-way":
             two_way_wall_s = self.total_s - self.compile_s
         if two_way_wall_s is not None:
@@ -135,9 +137,9 @@ class Result:
         """The advisor's verdict for any interaction (its ``describe()``) from this run."""
         return self._advice(None, None, it)
 
-    def _advice(self, one_way_stable, two_way_cost_s, it=None) -> dict:
+    def _advice(self, one_way_stable, two_way_cost_s, it=None, debug_cycle=None) -> dict:
         """The advisor's verdict for the interaction described by ``it`` (default: the
-        scene's main interaction)."""
+        scene's main interaction); debug_cycle: analysis/advisor.py ``advise``."""
         it = self.main_interaction if it is None else it
         if it is None:
             return {"mode": None, "reasons": ["no interaction acts on a moving system"]}
@@ -146,7 +148,7 @@ class Result:
         if two_way_cost_s is None and it["mode"] == "two-way":
             two_way_cost_s = self.work
         return advise(interaction_stats(self.logs[it["name"]]), it, one_way_stable,
-                      two_way_cost_s)
+                      two_way_cost_s, debug_cycle=debug_cycle)
 
     def summary(self, **advice_kw) -> dict:
         return {"scene": self.scene, "coupling": self.coupling, "duration_s": self.duration,

@@ -13,7 +13,7 @@ WORK_BUDGET = 6e9
 
 def advise(stats: dict, interaction: dict, one_way_stable: bool | None = None,
            two_way_work: float | None = None, work_budget: float = WORK_BUDGET,
-           significant_fraction: float = 0.1) -> dict:
+           significant_fraction: float = 0.1, debug_cycle: dict | None = None) -> dict:
     """The decision tree of the paper's Figure 17, with the measured reasons.
 
     interaction: its ``describe()`` (the primary's role, the stand-in, whether two-way is
@@ -22,6 +22,10 @@ def advise(stats: dict, interaction: dict, one_way_stable: bool | None = None,
     one_way_stable: whether a one-way run of the secondary stayed stable (None: not measured).
     two_way_work: state values a two-way run advanced (None: not measured); expensive above
     work_budget.
+    debug_cycle: for a primary tuned by hand (the paper's gymnast), the measured wall times
+    {"two_way_s": the two-way run, "primary_s": the stand-in's primary pass, "ratio": how
+    many times faster the animator's debug cycle must be than two-way}; two-way is then too
+    expensive when it takes more than ratio x the primary pass (None: not a criterion).
     """
     if interaction["primary_role"] != "dynamic":
         return {"mode": "one-way", "reasons": [
@@ -49,6 +53,14 @@ def advise(stats: dict, interaction: dict, one_way_stable: bool | None = None,
     if two_way_work is not None:
         reasons.append(f"a two-way run advances {two_way_work:.3g} state values (budget "
                        f"{work_budget:.3g})")
+    if debug_cycle is not None and debug_cycle.get("two_way_s") and debug_cycle.get("primary_s"):
+        t2, tp, r = debug_cycle["two_way_s"], debug_cycle["primary_s"], debug_cycle["ratio"]
+        slow = t2 > r * tp
+        reasons.append(f"her controller is tuned by hand: two-way took {t2:.2f} s, the "
+                       f"stand-in's primary pass {tp:.2f} s ({t2 / tp:.1f}x); a debug cycle "
+                       f"must be at most 1/{r:g} of two-way"
+                       + (": two-way is too slow to tune with" if slow else ": two-way will do"))
+        expensive = expensive or slow
     if supported and not expensive:
         reasons.append("two-way coupling is implemented and affordable")
         return {"mode": "two-way", "reasons": reasons}

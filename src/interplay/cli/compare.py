@@ -28,10 +28,16 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
     one_way_stable = (not any(results["one-way"].warnings)) if "one-way" in results else None
     two_way_cost = reference.work if reference is not None else None
     wall = reference.total_s - reference.compile_s if reference is not None else None
+    debug = None
+    if spec.debug_ratio is not None and wall is not None and "hybrid" in results:
+        # a primary tuned by hand: the advisor weighs the measured debug cycles
+        debug = {"two_way_s": wall, "primary_s": results["hybrid"].primary_cycle_s,
+                 "ratio": spec.debug_ratio}
     rows, paths = {}, []
     for mode, r in results.items():
         summary = scene_summary(spec, r, one_way_stable=one_way_stable,
-                                two_way_work=two_way_cost, two_way_wall_s=wall)
+                                two_way_work=two_way_cost, two_way_wall_s=wall,
+                                debug_cycle=debug)
         if options is None:
             paths += r.save(out / mode, summary)
         else:
@@ -40,8 +46,12 @@ def compare_modes(spec, kw, out: Path, quiet: bool, console, options=None) -> di
         rows[mode] = mode_row(r, summary.get("figures", {}))
     first = reference or next(iter(results.values()))
     advice = first.advice(one_way_stable=one_way_stable, two_way_work=two_way_cost,
-                          two_way_wall_s=wall)
+                          two_way_wall_s=wall, debug_cycle=debug)
     report = {"scene": spec.name, "modes": rows, "advice": advice}
+    if spec.contrast is not None:
+        report["contrast"] = spec.contrast(results)
+        for label, value in report["contrast"].items():
+            console.print(f"{label}: {figure_text(value)}", markup=False)
     path = out / "compare.json"
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(report, indent=2))

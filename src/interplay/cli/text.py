@@ -35,7 +35,7 @@ def print_run(console, result, figures: dict | None = None):
     console.print(table)
     adv = result.advice()
     console.print(f"advice: [bold]{adv['mode']}[/bold] - " + "; ".join(adv["reasons"]))
-    # the other interactions on a moving primary (a figure's vest beside its noose)
+    # the other interactions on a moving primary, each with its own verdict
     for it in result.interactions:
         if it["name"] != result.main and it["primary_role"] == "dynamic":
             other = result.advice_for(it)

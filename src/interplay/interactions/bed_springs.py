@@ -126,10 +126,12 @@ class BedSprings(StandIn):
             return self._zero, self._zero, False
         on = np.flatnonzero(depth > max(D - p.pocket, 0.0))
         part, xs, d = self.part[on], x[on], depth[on] - max(D - p.pocket, 0.0)
-        lin, ang = view.velocities()
+        # velocities of the touching parts only (a figure asks MuJoCo once per part)
+        touched, slot = np.unique(part, return_inverse=True)
+        lin, ang = view.velocities(touched)
         com = view.centres()
         r = xs - com[part]
-        v = lin[part] + np.cross(ang[part], r)
+        v = lin[slot] + np.cross(ang[slot], r)
         deep = int(np.argmax(d))
         fz = max(p.force(D) - p.damping * v[deep, 2], 0.0)  # dD/dt = -v_z
         share = fz * d / d.sum()
@@ -140,7 +142,6 @@ class BedSprings(StandIn):
         cap = np.minimum(p.friction_damping, p.friction * share / np.maximum(speed, 1e-12))
         f[:, :2] = -cap[:, None] * vt
         tau = np.cross(r, f)
-        touched = np.unique(part)
         for j in touched:
             sel = part == j
             view.apply(int(j), f[sel].sum(axis=0), tau[sel].sum(axis=0))

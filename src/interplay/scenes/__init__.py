@@ -6,8 +6,8 @@ import importlib
 from ..errors import SceneError
 
 #: the scene modules, loaded on demand (a scene's module imports its systems)
-MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "owl_creek", "pond",
-           "puddle", "runner", "stunt_kite", "trampoline")
+MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "mat", "owl_creek",
+           "pond", "puddle", "runner", "stunt_kite", "trampoline")
 
 
 def spec(name: str):

@@ -26,7 +26,14 @@ class SceneSpec:
     and compare tables; searches: the ``control.search.Search``es ``interplay tune`` can run
     on it (the first is the default); heavy: its build alone takes tens of seconds (the
     runner cuts and dresses garments), so the every-scene tests that build it many times
-    (the fuzz, every CLI verb) run it only in the slow suite.
+    (the fuzz, every CLI verb) run it only in the slow suite; fit: (spec, params, **build
+    keywords) -> report, a scene's own stand-in fit for ``fit-standin`` instead of matching
+    the velocity at fit_time (the mat's: its curve to the mat's load-deflection; the report's
+    "sets" are the fitted --set lines); debug_ratio: its primary is tuned by hand, so
+    ``compare``'s advisor wants its debug cycle at most 1/debug_ratio of two-way's
+    (analysis/advisor.py; None: the advisor counts work only); contrast: {mode: Result} ->
+    {label: value}, figures across the couplings for ``compare`` (the mat's: hybrid's
+    centre-of-mass path off two-way's).
     """
     name: str
     description: str
@@ -43,6 +50,9 @@ class SceneSpec:
     figures: Callable | None = field(default=None, compare=False)
     searches: tuple = field(default=(), compare=False)
     heavy: bool = False
+    fit: Callable | None = field(default=None, compare=False)
+    debug_ratio: float | None = None
+    contrast: Callable | None = field(default=None, compare=False)
 
     @property
     def default_coupling(self) -> str:
@@ -99,7 +109,7 @@ class SceneSpec:
                              f"{_list([s.name for s in self.searches])}")
 
     def check_fit(self):
-        if self.standin is None or self.fit_time is None:
+        if self.standin is None or (self.fit_time is None and self.fit is None):
             raise SceneError(f"{self.name} has no stand-in that fit-standin can fit"
                              f"{'' if 'hybrid' in self.couplings else ' (no hybrid coupling)'}"
                              "; scenes with one: "
@@ -113,4 +123,5 @@ def _list(items) -> str:
 
 def fittable():
     from . import all_specs
-    return [s for s in all_specs() if s.standin is not None and s.fit_time is not None]
+    return [s for s in all_specs() if s.standin is not None
+            and (s.fit_time is not None or s.fit is not None)]

@@ -100,7 +100,7 @@ def bed(p: BedParams, integrator: str = "explicit", dt: float | None = None) -> 
 EXPLICIT_SHARE = 2.5
 
 
-def check_explicit(net: SpringNetwork):
+def check_explicit(net: SpringNetwork, key: str = "bed.dt"):
     """Refuse an explicit step at which the bed's stiffest point is unstable: symplectic Euler
     with damping, x'' + c x' + w^2 x = 0, is stable for h c < 2 and h^2 w^2 + 2 h c < 4, here
     with w^2 = sum k / m and c = beta sum k / m + alpha, the highest in-plane mode of a grid
@@ -119,7 +119,7 @@ def check_explicit(net: SpringNetwork):
         bound = float(np.min((np.sqrt(c * c + EXPLICIT_SHARE * w2) - c) / w2))
         raise StabilityError(
             f"{net.name}: dt={h:.3g} s is too large for its stiffness and damping (explicit "
-            f"stability number {worst:.2f}, at most {EXPLICIT_SHARE}); use bed.dt <= "
+            f"stability number {worst:.2f}, at most {EXPLICIT_SHARE}); use {key} <= "
             f"{bound:.2g} s, or less stretch or stiffness_damping")
 
 

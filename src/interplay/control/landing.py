@@ -1,0 +1,168 @@
+"""A vault's second flight and its landing (SPEC 4, the floor mat): the take-off state off the
+vault table and the landing controller that sticks it.
+
+Take-off (``VaultParams``): the gymnast leaves the table after a handspring with her centre
+of mass ``vx`` m/s forward and ``vz`` m/s up, her body past the handstand by ``pitch0 - pi``
+rad and turning forward at ``spin`` rad/s. Published second-flight kinematics of handspring
+vaults put the horizontal velocity at table take-off at about 3-4 m/s and the vertical at
+about 2-3 m/s, with forward rotation (Takei 1991, 1998; Naundorf et al. 2008; docs/mat.md).
+
+The state machine (control/fsm.py), in the paper's style:
+
+* ``flight``: straight body, arms overhead, toes pointed, while she turns over; once the
+  trunk is within ``prepare_at`` rad of upright (``pitch_above``, with a look-ahead of
+  ``spot`` s at her rate, as gymnasts spot the landing) she hands over to
+* ``prepare``: legs forward (hips flexed to ``hip_prepare``, knees a little bent), feet
+  flat, arms up; on foot contact
+* ``touchdown``: absorb with hips, knees and ankles (flexed to ``hip_absorb``,
+  ``knee_absorb``, ``ankle_absorb``) on soft servos (``absorb_omega``), the arms coming
+  forward; after ``absorb`` s
+* ``hold``: arms out to the sides, knees soft, the ankles balancing the centre of mass over
+  the feet (the figure's ankle strategy and ``LandingBalance``): she stands, no step.
+
+Angles in rad (anatomical sense: flexion positive; ankle flexion is dorsiflexion), times in
+s.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.anthropometry import BodyParams
+from ..params import param
+from ..systems.figure import Figure, FigureParams
+from ..systems.figure_model import EnvironmentParams
+from .bounce import BounceBalance, BounceParams
+from .fsm import Controller, State, Transition
+
+HOLD_BALANCE = (0.6, 0.25)  # rad/m, rad s/m: the figure's ankle strategy while she holds
+
+
+@dataclass(frozen=True)
+class VaultParams:
+    """The take-off off the table and the landing controller (module docstring): the gymnast
+    (64.38 kg, 1.70 m: the paper's Table I gymnast); table (m): the vault table's height;
+    com0 (m): her centre of mass above the table at take-off; vx, vz (m/s); pitch0 (rad: the
+    trunk's forward turn from upright, pi = inverted); spin (rad/s forward); prepare_at
+    (rad), spot (s); the landing posture hip_prepare, knee_prepare, ankle_prepare (negative:
+    toes pointed, so the toes land first and the ankles start the absorption), arms_prepare
+    (rad of shoulder flexion); the absorption hip_absorb, knee_absorb, ankle_absorb (rad), its servo
+    frequency absorb_omega (rad/s) and damping ratio absorb_zeta (-: the stance legs' servos
+    act on the whole body's inertia, so a critically damped one resists a fast flexion with
+    kilonewtons and throws her back up) and time absorb (s); hold: arms_out (rad of shoulder
+    abduction), knee_hold (rad); the balance over the feet on landing: k_lead (rad/m),
+    k_drift (rad s/m), k_spin (rad per kg m^2/s), k_attitude (-), and in the air k_speed
+    (s): the feet are placed ahead of the centre of mass by k_speed times its horizontal
+    speed."""
+    mass: float = param(64.38, "kg", ge=10.0, le=500.0)
+    height: float = param(1.70, "m", ge=0.5, le=3.0)
+    table: float = param(1.25, "m", ge=0.0, le=5.0, doc="vault table height")
+    com0: float = param(0.95, "m", ge=0.0, le=3.0, doc="centre of mass above the table")
+    vx: float = param(3.3, "m/s", ge=-20.0, le=20.0, doc="horizontal take-off velocity")
+    vz: float = param(2.5, "m/s", ge=-20.0, le=20.0, doc="vertical take-off velocity")
+    pitch0: float = param(3.45, "rad", ge=-7.0, le=7.0, doc="trunk's turn from upright")
+    spin: float = param(3.0505318143348936, "rad/s", ge=-30.0, le=30.0, doc="forward rotation")
+    prepare_at: float = param(1.289203401370083, "rad", ge=0.0, le=3.2)
+    spot: float = param(0.05, "s", ge=0.0, le=2.0)
+    hip_prepare: float = param(0.38, "rad", ge=-0.5, le=2.5)
+    knee_prepare: float = param(0.5553289705199036, "rad", ge=0.0, le=2.5)
+    ankle_prepare: float = param(-0.24664499792756536, "rad", ge=-1.0, le=1.0, doc="toes first")
+    arms_prepare: float = param(3.1, "rad", ge=-1.0, le=3.2)
+    hip_absorb: float = param(1.1602116944013092, "rad", ge=0.0, le=2.5)
+    knee_absorb: float = param(1.433029864950313, "rad", ge=0.0, le=2.5)
+    ankle_absorb: float = param(0.45966060729222497, "rad", ge=-0.5, le=1.0)
+    absorb_omega: float = param(6.4413535587524295, "rad/s", gt=0.0, le=100.0)
+    absorb_zeta: float = param(0.4226930255088814, "-", gt=0.0, le=10.0, doc="the absorption's damping")
+    absorb: float = param(0.4598196141367603, "s", ge=0.0, le=5.0)
+    arms_out: float = param(1.4, "rad", ge=0.0, le=3.2)
+    knee_hold: float = param(0.26493408981094, "rad", ge=0.0, le=2.5)
+    k_lead: float = param(0.7378086688913733, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.2617214836251076, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.01, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.0, "-", ge=0.0, le=3.0)
+    k_speed: float = param(0.11655555301703205, "s", ge=0.0, le=5.0)
+
+
+def controller(p: VaultParams) -> Controller:
+    """flight -> prepare -> touchdown -> hold, starting in flight (off the table)."""
+    flight = State("flight", pose=(("hip", 0.0), ("knee", 0.0), ("ankle", -0.5), ("waist", 0.0),
+                                   ("neck", 0.0), ("shoulder_flex", 3.0), ("shoulder_abd", 0.0),
+                                   ("elbow", 0.0), ("toe", 0.0)),
+                   transitions=(Transition("pitch_above", "prepare", -p.prepare_at,
+                                           lookahead=p.spot),), blend=0.0)
+    # the legs are soft already in the air: a leg held stiff meets the ground as a rod, and
+    # the impact throws her back up (measured: a 16 kN spike and a 0.2 m rebound on a rigid
+    # floor) before the touch-down state's first tick
+    legs = (("hip", p.absorb_omega), ("knee", p.absorb_omega), ("ankle", p.absorb_omega))
+    prepare = State("prepare", pose=(("hip_flex", p.hip_prepare), ("hip_abd", 0.0),
+                                     ("knee", p.knee_prepare), ("ankle", p.ankle_prepare),
+                                     ("shoulder_flex", p.arms_prepare), ("shoulder_abd", 0.0),
+                                     ("elbow", 0.0)), gains=legs,
+                    blend=0.15, transitions=(Transition("foot_contact", "touchdown"),))
+    touchdown = State("touchdown", pose=(("hip_flex", p.hip_absorb), ("knee", p.knee_absorb),
+                                         ("ankle", p.ankle_absorb), ("shoulder_flex", 1.5),
+                                         ("elbow", 0.1)),
+                      gains=legs, zeta=p.absorb_zeta, support=True, blend=0.0,
+                      transitions=(Transition("time", "hold", p.absorb),))
+    hold = State("hold", pose=(("hip_flex", 0.5 * p.knee_hold), ("hip_abd", 0.0),
+                               ("knee", p.knee_hold), ("ankle", 0.5 * p.knee_hold),
+                               ("waist", 0.0), ("neck", 0.0), ("shoulder_flex", 0.0),
+                               ("shoulder_abd", p.arms_out), ("elbow", 0.1), ("toe", 0.0)),
+                 support=True, balance=HOLD_BALANCE, blend=0.6)
+    return Controller((flight, prepare, touchdown, hold), start="flight")
+
+
+class LandingBalance(BounceBalance):
+    """The figure's feedback for a landing (the trampoline's balance law, control/bounce.py,
+    reused): in the air, from ``prepare`` on, the feet are placed ahead of the centre of mass
+    by k_speed times its speed; on the ground the ankles steer the centre of mass over the feet
+    and the hips hold the pelvis upright over the legs. Nothing while she turns over in
+    ``flight`` (the placement's angles mean nothing upside down)."""
+
+    def __init__(self, p: VaultParams, joints):
+        bp = BounceParams(k_speed=p.k_speed, k_place=0.0, k_lead=p.k_lead, k_drift=p.k_drift,
+                          k_spin=p.k_spin, k_attitude=p.k_attitude, k_turn=0.0,
+                          k_hip_spin=0.0, k_arms=0.0)
+        super().__init__(bp, joints)
+
+    def offsets(self, fig, sensors) -> np.ndarray:
+        if fig.fsm.state.name == "flight":
+            return self.out
+        return super().offsets(fig, sensors)
+
+
+def rotation_y(angle: float) -> np.ndarray:
+    """MuJoCo quaternion (w, x, y, z) of a turn of ``angle`` rad about +y (forward pitch for a
+    figure facing +x)."""
+    return np.array([math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0])
+
+
+def gymnast(p: VaultParams, floor: float | None, takeoff_x: float = 0.0,
+            air_density: float = 1.2, name: str = "gymnast") -> Figure:
+    """The gymnast leaving the table: her centre of mass at (takeoff_x, 0, table + com0) m
+    moving (vx, 0, vz) m/s, the body in its flight posture turned pitch0 rad forward and
+    turning at spin rad/s about her left-right axis; floor (m): MuJoCo's ground under her."""
+    env = EnvironmentParams(floor=floor, air_density=air_density)
+    fig = Figure(name, FigureParams(body=BodyParams(p.mass, p.height), environment=env,
+                                    position=(takeoff_x, 0.0, p.table)), controller(p))
+    fig.feedback = LandingBalance(p, fig.joints)
+    d, mj = fig.data, fig._mj
+    d.qpos[fig.qadr] = fig.targets  # the flight posture the controller starts in
+    d.qpos[3:7] = rotation_y(p.pitch0)
+    d.qvel[:] = 0.0
+    mj.mj_forward(fig.model, d)
+    com = fig.com()
+    d.qpos[:3] += np.array([takeoff_x, 0.0, p.table + p.com0]) - com
+    mj.mj_forward(fig.model, d)
+    # the whole body turning at w about its centre of mass: the root moves at v + w x r
+    w = np.array([0.0, p.spin, 0.0])
+    r = d.qpos[:3] - fig.com()
+    d.qvel[:3] = np.array([p.vx, 0.0, p.vz]) + np.cross(w, r)
+    R = d.xmat[fig.root].reshape(3, 3)
+    d.qvel[3:6] = R.T @ w  # MuJoCo's free joint: angular velocity in the body frame
+    d.qvel[6:] = 0.0
+    mj.mj_forward(fig.model, d)
+    fig._plan(0.0)
+    return fig

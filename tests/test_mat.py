@@ -1,0 +1,151 @@
+"""The floor mat (issue 17): the mat's statics against a static solve; the stand-in's fitted
+curve against the mat's measured load-deflection; the hybrid coupling invariants (her pass
+never reads the mat); equal and opposite forces in two-way; a vault that misses the mat.
+Slow: the default run's landing."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from interplay.cli.command import main  # noqa: E402
+from interplay.errors import SceneError  # noqa: E402
+from interplay.geometry.mat import MatParams  # noqa: E402
+from interplay.scenes import mat as M  # noqa: E402
+
+G = 9.81
+H = 1e-3  # s, the coupling step
+SMALL = MatParams(length=0.6, width=0.4, nx=7, ny=5, nz=3)  # 105 points: a statics test
+
+
+def _static_solve(net, load):
+    """A slow reference: the mat's rest under the load as the minimum of its potential energy
+    (springs, gravity, the load) by L-BFGS from the unloaded block, bottom held."""
+    from scipy.optimize import minimize
+    free = np.setdiff1d(np.arange(len(net.x)), net.bottom)
+    x0 = net.x.copy()
+    sel = M.pressed_points(net)
+    f = np.zeros_like(x0)
+    f[sel, 2] = -load / len(sel)
+    f[:, 2] -= net.m * G
+
+    def energy(u):
+        x = x0.copy()
+        x[free] = u.reshape(-1, 3)
+        d = x[net.si] - x[net.sj]
+        ln = np.linalg.norm(d, axis=1)
+        e = ln - net.l0
+        g = (net.k * e / ln)[:, None] * d
+        grad = np.zeros_like(x)
+        np.add.at(grad, net.si, g)
+        np.add.at(grad, net.sj, -g)
+        grad -= f
+        return 0.5 * float(net.k @ (e * e)) - float((f * x).sum()), grad[free].ravel()
+    res = minimize(energy, x0[free].ravel(), jac=True, method="L-BFGS-B",
+                   options={"maxiter": 20000, "gtol": 1e-8, "ftol": 1e-16, "maxcor": 30})
+    x = x0.copy()
+    x[free] = res.x.reshape(-1, 3)
+    return x, np.abs(res.jac).max()
+
+
+def test_mat_under_load_rests_at_the_static_solution():
+    """Two feet's worth of load (a 64 kg gymnast standing, 631 N, over the central 0.3 m
+    square) on a small mat: its relaxation (damped backward Euler, the load ramped) and a
+    static solve agree on the depression. Tolerance: both end with residual forces r below
+    0.01 N per point; the mat's vertical stiffness there is K ~ 4e4 N/m (load / depression),
+    so they agree to 2 r / K < 1e-6 m; 1e-5 m leaves room for the relaxation's last step."""
+    load = 631.0
+    net = M.mat_network(SMALL, "implicit")
+    got = M.press(net, load, seconds=1.0)
+    x_ref, residual = _static_solve(M.mat_network(SMALL, "implicit"), load)
+    ref = SMALL.thickness - x_ref[net.top, 2].min()
+    assert residual < 0.01
+    assert abs(got - ref) < 1e-5
+    assert 0.005 < got < 0.1  # foam, not a trampoline: centimetres under a standing gymnast
+
+
+def test_shipped_stand_in_reproduces_the_mats_load_deflection():
+    """The stand-in's curve (the shipped defaults, ``interplay fit-standin mat``) gives the
+    force the default mat measures at its depression, within 10%, over the landing's range
+    (1, 8 and 16 body weights on two feet: the default landing's peak is about 15)."""
+    p = M.MatSceneParams()
+    weight = p.vault.mass * G
+    rows = M.load_deflection(p.mat, [b * weight for b in (1.0, 8.0, 16.0)])
+    model = p.standin.force(rows[:, 1])
+    assert np.all(np.abs(model - rows[:, 0]) <= 0.10 * rows[:, 0])
+    # and the mat stiffens as foam under a cover does: its secant stiffness rises with load
+    assert np.all(np.diff(rows[:, 0] / rows[:, 1]) > 0)
+
+
+def _pass(params, coupling="hybrid", duration=1.0):
+    return M.build(coupling, duration=duration, params=params).simulate(primary_only=True)
+
+
+def test_hybrid_primary_pass_never_reads_the_mat():
+    """Her hybrid pass is the same, bit for bit, whatever the mat is (a mat twice as stiff,
+    heavier, coarser): the stand-in alone acts on her; and with the stand-in off it is the
+    one-way pass (she falls through to the floor)."""
+    p = M.MatSceneParams()
+    other = replace(p, mat=replace(p.mat, modulus=1.2e5, mass=60.0, nx=13, ny=9, nz=3))
+    a, b = _pass(p), _pass(other)
+    ta, tb = a.tracks["gymnast"], b.tracks["gymnast"]
+    assert np.array_equal(ta.x, tb.x) and np.array_equal(ta.xdot, tb.xdot)
+    off = replace(p, standin=replace(p.standin, enabled=False))
+    c, d = _pass(off), _pass(p, "one-way")
+    tc, td = c.tracks["gymnast"], d.tracks["gymnast"]
+    assert np.array_equal(tc.x, td.x) and np.array_equal(tc.xdot, td.xdot)
+
+
+def test_two_way_forces_are_equal_and_opposite_every_step():
+    """Two-way, through the landing: at every coupling step the impulse the mat's points
+    received is minus the impulse her segments received (to round-off), and what the figure
+    is given is that impulse over the step."""
+    sc = M.build("two-way", duration=1.0)
+    fig = sc.primary
+    net = next(s for s in sc.systems if s.name == "mat")
+    contact = sc.interactions[0]
+    contact.prepare(H, {net.name: net.dt, fig.name: fig.dt})
+    touched = 0
+    for _ in range(950):
+        fig.clear_forces()
+        net.clear_forces()
+        res = contact.exchange(True, True)
+        net.advance(H, net.dt)
+        if res is None:
+            res = contact.complete(True)
+        P = contact.parts
+        given = P.impulses[:, :3].sum(axis=0)
+        scale = max(np.abs(given).max(), 1e-9)
+        assert np.allclose(P.received, -given, atol=1e-9 * scale)
+        if res[2]:
+            touched += 1
+            assert np.allclose(fig.segment_wrenches()[:, :3].sum(axis=0), given / H,
+                               atol=1e-9 * scale / H)
+        fig.advance(H)
+    assert touched > 50  # she touches down at ~0.8 s: the contact acted on 50+ steps
+
+
+def test_a_vault_that_misses_the_mat_is_refused_in_one_line(capsys):
+    """Too fast off the table she lands past the mat: a SceneError naming where she comes
+    down and where the mat is, one line and exit 2 on the command line."""
+    p = M.MatSceneParams()
+    fast = replace(p, vault=replace(p.vault, vx=6.0))
+    with pytest.raises(SceneError, match="misses the mat"):
+        M.build(params=fast)
+    assert main(["run", "mat", "--set", "vault.vx=6", "--no-video", "--no-usd",
+                 "--no-report", "--out", "/nonexistent/never"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "misses the mat" in err[0]
+
+
+@pytest.fixture(scope="module")
+def default_run():
+    return M.build("hybrid").simulate()
+
+
+@pytest.mark.slow
+def test_default_run_sticks_the_landing_and_depresses_the_mat(default_run):
+    fig = M.landing_figures(default_run)
+    assert fig["stuck"], fig
+    assert 0.05 <= fig["mat depression (m)"] <= 0.2
