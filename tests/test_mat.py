@@ -13,6 +13,7 @@ from interplay.cli.command import main  # noqa: E402
 from interplay.errors import SceneError  # noqa: E402
 from interplay.geometry.mat import MatParams  # noqa: E402
 from interplay.scenes import mat as M  # noqa: E402
+from contact_checks import equal_and_opposite_every_step  # noqa: E402
 
 G = 9.81
 H = 1e-3  # s, the coupling step
@@ -101,28 +102,7 @@ def test_two_way_forces_are_equal_and_opposite_every_step():
     """Two-way, through the landing: at every coupling step the impulse the mat's points
     received is minus the impulse her segments received (to round-off), and what the figure
     is given is that impulse over the step."""
-    sc = M.build("two-way", duration=1.0)
-    fig = sc.primary
-    net = next(s for s in sc.systems if s.name == "mat")
-    contact = sc.interactions[0]
-    contact.prepare(H, {net.name: net.dt, fig.name: fig.dt})
-    touched = 0
-    for _ in range(950):
-        fig.clear_forces()
-        net.clear_forces()
-        res = contact.exchange(True, True)
-        net.advance(H, net.dt)
-        if res is None:
-            res = contact.complete(True)
-        P = contact.parts
-        given = P.impulses[:, :3].sum(axis=0)
-        scale = max(np.abs(given).max(), 1e-9)
-        assert np.allclose(P.received, -given, atol=1e-9 * scale)
-        if res[2]:
-            touched += 1
-            assert np.allclose(fig.segment_wrenches()[:, :3].sum(axis=0), given / H,
-                               atol=1e-9 * scale / H)
-        fig.advance(H)
+    touched = equal_and_opposite_every_step(M.build("two-way", duration=1.0), "mat", H, 950)
     assert touched > 50  # she touches down at ~0.8 s: the contact acted on 50+ steps
 
 

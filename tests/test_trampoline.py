@@ -27,6 +27,7 @@ from interplay.systems.rigid import RigidBody  # noqa: E402
 from interplay.geometry.primitive import Primitive  # noqa: E402
 from interplay.kernels.rigid import quat_to_matrix  # noqa: E402
 from interplay.systems.colliders import box_surface  # noqa: E402
+from contact_checks import equal_and_opposite_every_step  # noqa: E402
 
 G = 9.81
 H = 1e-3  # s, the coupling step
@@ -260,26 +261,7 @@ def test_contact_forces_on_gymnast_and_bed_are_equal_and_opposite_every_step():
     her segments is minus the impulse her segments received (to round-off), and what the
     figure is given is that impulse over the step."""
     sc = T.build("two-way", duration=1.5)
-    fig, net = sc.primary, sc.systems[2]
-    contact = sc.interactions[0]
-    contact.prepare(H, {net.name: net.dt, fig.name: fig.dt})
-    touched = 0
-    for _ in range(1200):
-        fig.clear_forces()
-        net.clear_forces()
-        res = contact.exchange(True, True)
-        net.advance(H, net.dt)
-        if res is None:
-            res = contact.complete(True)
-        P = contact.parts
-        given = P.impulses[:, :3].sum(axis=0)
-        scale = max(np.abs(given).max(), 1e-9)
-        assert np.allclose(P.received, -given, atol=1e-9 * scale)
-        if res[2]:
-            touched += 1
-            assert np.allclose(fig.segment_wrenches()[:, :3].sum(axis=0), given / H,
-                               atol=1e-9 * scale / H)
-        fig.advance(H)
+    touched = equal_and_opposite_every_step(sc, sc.systems[2].name, H, 1200)
     assert touched > 300
 
 
