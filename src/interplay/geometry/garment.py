@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ParameterError
 from ..params import param
-from .body_surface import BodySurface, body_distance
+from . import body_fit as BF
+from .body_surface import BodySurface
 # the network of a garment (systems/garments.py) is part of this API
 from ..systems.garments import BAND_TENSION, LATTICE, network, spring_set  # noqa: F401,E402
 from .garment_mesh import (DRESS_DEPTH, boundary_loops, check_garment,  # noqa: F401 - the API
@@ -113,70 +113,6 @@ class Garment:
         return self.area * self.fabric.density
 
 
-# --- body measurements ---------------------------------------------------------------------------
-def _parts(surface: BodySurface, names):
-    idx = [k for k, s in enumerate(surface.plan) if s.name in names]
-    return idx
-
-
-def _girth_radius(surface, seg_idx, centre, dirs, offset, allow_empty=False):
-    """Distance along each ray (centre (k,3) + r dirs (k,3)) to the outermost point within
-    ``offset`` (m) of the solids ``seg_idx``: the ring that fits around them with that ease."""
-    r = np.linspace(0.0, 0.45, 226)
-    pts = (centre[:, None, :] + r[None, :, None] * dirs[:, None, :]).reshape(-1, 3)
-    sol = [surface.solids[k] for k in seg_idx]
-    d = body_distance(pts, sol, surface.pos0[seg_idx], surface.rot0[seg_idx],
-                      surface.params.blend).reshape(len(dirs), len(r))
-    inside = d <= offset
-    last = np.where(inside.any(axis=1), len(r) - 1 - np.argmax(inside[:, ::-1], axis=1), 0)
-    out = r[last]
-    # refine between the last sample inside and the next by bisection
-    if not allow_empty and not inside.any(axis=1).all():
-        k = int(np.argmin(inside.any(axis=1)))
-        raise ParameterError(f"garment fit: no body part around ray {k} from {centre[k]} "
-                             f"towards {dirs[k]}; the garment reaches past the body here")
-    lo, hi = out, np.minimum(out + r[1], r[-1])
-    for _ in range(20):
-        mid = 0.5 * (lo + hi)
-        p = centre + mid[:, None] * dirs
-        dm = body_distance(p, sol, surface.pos0[seg_idx], surface.rot0[seg_idx],
-                           surface.params.blend)
-        lo, hi = np.where(dm <= offset, mid, lo), np.where(dm <= offset, hi, mid)
-    return np.where(inside.any(axis=1), lo, 0.0)
-
-
-def _ring(surface, seg_idx, centre, u, w, angles, offset, allow_empty=False):
-    """Points of a ring about centre in the plane (u, w): at each angle, the fitted radius."""
-    dirs = np.cos(angles)[:, None] * u + np.sin(angles)[:, None] * w
-    c = np.broadcast_to(centre, dirs.shape)
-    r = _girth_radius(surface, seg_idx, np.ascontiguousarray(c), dirs, offset, allow_empty)
-    return c + r[:, None] * dirs
-
-
-def _convex_radii(ring, centre_xy, angles):
-    """Radii at ``angles`` of the convex hull of a horizontal ring (a panel bridges hollows)."""
-    from scipy.spatial import ConvexHull
-    p = ring[:, :2] - centre_xy
-    hull = p[ConvexHull(p).vertices]
-    a, b = hull, np.roll(hull, -1, axis=0)
-    out = np.zeros(len(angles))
-    for k, t in enumerate(angles):
-        d = np.array([np.cos(t), np.sin(t)])
-        # ray-segment intersections: the hull contains the centre, one exit
-        e = b - a
-        den = d[0] * e[:, 1] - d[1] * e[:, 0]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s = (a[:, 0] * e[:, 1] - a[:, 1] * e[:, 0]) / den
-            u = (a[:, 0] * d[1] - a[:, 1] * d[0]) / den
-        ok = (s > 0) & (u >= -1e-9) & (u <= 1 + 1e-9)
-        out[k] = s[ok].max()
-    return out
-
-
-def _circumference(p) -> float:
-    return float(np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum())
-
-
 # --- mesh assembly --------------------------------------------------------------------------------
 class _Builder:
     def __init__(self):
@@ -225,7 +161,7 @@ def _blend_tube(b, loop, loop_x, axis_pts, u, w, surface, seg_idx, offsets, spac
     angles = phi0[0] + sense * 2 * np.pi * s
     rows = [np.asarray(loop)]
     for k in range(1, len(axis_pts)):
-        ring = _ring(surface, seg_idx, centres[k], u[k], w[k], angles, offsets[k])
+        ring = BF.ring(surface, seg_idx, centres[k], u[k], w[k], angles, offsets[k])
         beta = min(1.0, k / blend_rows)
         pts = (1 - beta) * (loop_x + (axis_pts[k] - c0)) + beta * ring
         rows.append(b.add(pts))
@@ -316,7 +252,7 @@ def _torso_body(surface, fit, fabric, sleeves: bool, name: str, over=None) -> Ga
     armholes left open (sleeves sewn in when ``sleeves``); ``over``: a garment under it (its
     rings kept ``fit.ease`` / 2 outside that garment's vertices)."""
     P = {s.name: k for k, s in enumerate(surface.plan)}
-    trunk = _parts(surface, ("torso", "pelvis", "l_thigh", "r_thigh"))
+    trunk = BF.parts(surface, ("torso", "pelvis", "l_thigh", "r_thigh"))
     pos0 = surface.pos0
     z_hip = pos0[P["l_thigh"], 2]
     z_sh = pos0[P["l_upper_arm"], 2]
@@ -325,12 +261,12 @@ def _torso_body(surface, fit, fabric, sleeves: bool, name: str, over=None) -> Ga
     z_pit = z_sh - 1.9 * r_arm
     z_hem = z_hip - 0.03
     axis_xy = np.array([pos0[P["torso"], 0], 0.0])
-    chest = _ring(surface, trunk, np.array([*axis_xy, z_pit - 0.03]), np.array([1.0, 0, 0]),
+    chest = BF.ring(surface, trunk, np.array([*axis_xy, z_pit - 0.03]), np.array([1.0, 0, 0]),
                   np.array([0, 1.0, 0]), np.linspace(0, 2 * np.pi, 180, endpoint=False),
                   fit.ease)
-    N = _columns(_circumference(chest), fit.spacing, 4)
+    N = _columns(BF.circumference(chest), fit.spacing, 4)
     th = 2 * np.pi * np.arange(N) / N
-    r_chest = _convex_radii(_ring(surface, trunk, np.array([*axis_xy, z_pit - 0.03]),
+    r_chest = BF.convex_radii(BF.ring(surface, trunk, np.array([*axis_xy, z_pit - 0.03]),
                                   np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), th, fit.ease),
                             axis_xy, th)
     zs = np.linspace(z_hem, z_top, max(4, int(np.ceil((z_top - z_hem) / fit.spacing)) + 1))
@@ -338,11 +274,11 @@ def _torso_body(surface, fit, fabric, sleeves: bool, name: str, over=None) -> Ga
     b = _Builder()
     rows = []
     # the armhole's half-width at the armpit, in columns: about an arm's radius
-    m = int(np.clip(round(r_arm / (_circumference(chest) / N)), 1, N // 16))
+    m = int(np.clip(round(r_arm / (BF.circumference(chest) / N)), 1, N // 16))
     y_sh = float(pos0[P["l_upper_arm"], 1]) - 0.2 * r_arm  # the shoulder seam's outer end
     neck_half = 0.55 * float(surface.plan[P["head"]].shape[1])
     for i, z in enumerate(zs):
-        ring = _ring(surface, trunk, np.array([*axis_xy, z]), np.array([1.0, 0, 0]),
+        ring = BF.ring(surface, trunk, np.array([*axis_xy, z]), np.array([1.0, 0, 0]),
                      np.array([0, 1.0, 0]), th, fit.ease)
         if z < z_pit:
             # cut straight below the chest: the panels hang across the waist's hollow
@@ -359,7 +295,7 @@ def _torso_body(surface, fit, fabric, sleeves: bool, name: str, over=None) -> Ga
             front = np.cos(th) >= 0
             dirs = np.where(front[:, None], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0])
             c = np.stack([np.full(N, axis_xy[0]), y, np.full(N, z)], 1)
-            r = _girth_radius(surface, trunk, c, dirs, fit.ease, allow_empty=True)
+            r = BF.girth_radius(surface, trunk, c, dirs, fit.ease, allow_empty=True)
             # past the trunk's side (no body on the ray) the panel keeps the row below's depth
             below = np.abs(np.concatenate(b.x)[rows[-1]][:, 0] - axis_xy[0])
             r = np.where(r > 0, r, below)
@@ -417,14 +353,14 @@ def _torso_body(surface, fit, fabric, sleeves: bool, name: str, over=None) -> Ga
     neck = [rows[top][j] for j in range(N) if rows[top][j] not in weld
             and rows[top][j] not in weld.values()]
     groups["neck"] = np.array(neck)
-    sizes = {"chest_girth": _circumference(chest), "length": float(z_top - z_hem),
+    sizes = {"chest_girth": BF.circumference(chest), "length": float(z_top - z_hem),
              "columns": N}
     if not sleeves:
         return _finish(name, b, surface, fabric, fit, groups, [], sizes)
     x_all = np.concatenate(b.x)
     for side, loop in armholes:
         seg = P[f"{side[0]}_upper_arm"]
-        arm = _parts(surface, (f"{side[0]}_upper_arm",))
+        arm = BF.parts(surface, (f"{side[0]}_upper_arm",))
         a0 = surface.pos0[seg]
         bone = surface.rot0[seg] @ surface.plan[seg].bone
         L = float(np.linalg.norm(bone))
@@ -467,23 +403,23 @@ def sweatpants(surface: BodySurface, fit: Fit = Fit(ease=0.025),
     sewn to the crotch seam, elastic cuffs above the ankles."""
     P = {s.name: k for k, s in enumerate(surface.plan)}
     pos0 = surface.pos0
-    hips = _parts(surface, ("pelvis", "l_thigh", "r_thigh"))
+    hips = BF.parts(surface, ("pelvis", "l_thigh", "r_thigh"))
     z_w = pos0[P["torso"], 2] - 0.01
     z_hip = pos0[P["l_thigh"], 2]
     r_th = float(surface.plan[P["l_thigh"]].shape[1])
     z_c = z_hip - 0.8 * r_th  # the crotch
     band = 0.035  # m: waistband and cuff height
-    probe = _ring(surface, hips, np.array([0.0, 0.0, z_hip]), np.array([1.0, 0, 0]),
+    probe = BF.ring(surface, hips, np.array([0.0, 0.0, z_hip]), np.array([1.0, 0, 0]),
                   np.array([0, 1.0, 0]), np.linspace(0, 2 * np.pi, 180, endpoint=False),
                   fit.ease)
-    N = _columns(_circumference(probe), fit.spacing, 4)
+    N = _columns(BF.circumference(probe), fit.spacing, 4)
     th = 2 * np.pi * np.arange(N) / N
     zs = np.linspace(z_w, z_c, max(3, int(np.ceil((z_w - z_c) / fit.spacing)) + 1))
     b = _Builder()
     rows = []
     for z in zs:
         off = fit.band_ease if z > z_w - band else fit.ease * min(1.0, (z_w - z) / 0.1)
-        rows.append(b.add(_ring(surface, hips, np.array([0.0, 0.0, z]), np.array([1.0, 0, 0]),
+        rows.append(b.add(BF.ring(surface, hips, np.array([0.0, 0.0, z]), np.array([1.0, 0, 0]),
                                 np.array([0, 1.0, 0]), th, off)))
     for a, c in zip(rows[:-1], rows[1:]):
         b.band(a, c)
@@ -499,8 +435,8 @@ def sweatpants(surface: BodySurface, fit: Fit = Fit(ease=0.025),
     # the elastic band grips: its points ride the skin (systems.garments.Garments.ride)
     groups["pinned"] = groups["waistband"].copy()
     rings = [(_ring_edges([r for z, r in zip(zs, rows) if z > z_w - band]), fit.elastic)]
-    sizes = {"waist_girth": float(_circumference(np.concatenate(b.x)[rows[0]])),
-             "hip_girth": _circumference(probe), "columns": N}
+    sizes = {"waist_girth": float(BF.circumference(np.concatenate(b.x)[rows[0]])),
+             "hip_girth": BF.circumference(probe), "columns": N}
     for side in ("l", "r"):
         if side == "l":
             loop = np.concatenate([crotch[: N // 2 + 1], chain])
@@ -525,7 +461,7 @@ def sweatpants(surface: BodySurface, fit: Fit = Fit(ease=0.025),
         axis_pts[0] = start
         U = np.tile([1.0, 0.0, 0.0], (len(zl), 1))
         W = np.tile([0.0, 1.0, 0.0], (len(zl), 1))
-        leg = _parts(surface, (f"{side}_thigh", f"{side}_shank"))
+        leg = BF.parts(surface, (f"{side}_thigh", f"{side}_shank"))
         offs = np.where(zl < z_cuff + band, fit.band_ease, fit.ease)
         lrows = _blend_tube(b, loop, x_all[loop], axis_pts, U, W, surface, leg, offs,
                             fit.spacing)
@@ -547,11 +483,11 @@ def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
     its hem ``fit.length`` of the thigh below the hip joints."""
     P = {s.name: k for k, s in enumerate(surface.plan)}
     pos0 = surface.pos0
-    hips = _parts(surface, ("pelvis", "l_thigh", "r_thigh", "l_shank", "r_shank"))
+    hips = BF.parts(surface, ("pelvis", "l_thigh", "r_thigh", "l_shank", "r_shank"))
     z_w = pos0[P["torso"], 2] - 0.01
     thigh = float(np.linalg.norm(surface.plan[P["l_thigh"]].bone))
     z_hem = pos0[P["l_thigh"], 2] - fit.length * thigh
-    probe = _ring(surface, hips, np.array([0.0, 0.0, z_w - 0.1]), np.array([1.0, 0, 0]),
+    probe = BF.ring(surface, hips, np.array([0.0, 0.0, z_w - 0.1]), np.array([1.0, 0, 0]),
                   np.array([0, 1.0, 0]), np.linspace(0, 2 * np.pi, 180, endpoint=False),
                   fit.ease)
     hem_r = np.linalg.norm(probe[:, :2], axis=1).max() + (z_w - z_hem) * np.tan(
@@ -561,14 +497,14 @@ def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
     zs = np.linspace(z_w, z_hem, max(4, int(np.ceil((z_w - z_hem) / fit.spacing)) + 1))
     b = _Builder()
     rows = []
-    waist = _ring(surface, hips, np.array([0.0, 0.0, z_w]), np.array([1.0, 0, 0]),
+    waist = BF.ring(surface, hips, np.array([0.0, 0.0, z_w]), np.array([1.0, 0, 0]),
                   np.array([0, 1.0, 0]), th, fit.band_ease)
     # (the skirt's waistband grips like the pants')
     r_w = np.linalg.norm(waist[:, :2], axis=1)
     tan = np.tan(np.radians(fit.flare))
     band = 0.03
     for z in zs:
-        body = _ring(surface, hips, np.array([0.0, 0.0, z]), np.array([1.0, 0, 0]),
+        body = BF.ring(surface, hips, np.array([0.0, 0.0, z]), np.array([1.0, 0, 0]),
                      np.array([0, 1.0, 0]), th, fit.ease, allow_empty=True)
         r = np.maximum(np.linalg.norm(body[:, :2], axis=1), r_w + (z_w - z) * tan)
         if z > z_w - band:
@@ -579,8 +515,8 @@ def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
     bandrows = [r for z, r in zip(zs, rows) if z > z_w - band]
     groups = {"waist": rows[0].copy(), "waistband": np.concatenate(bandrows),
               "hem": rows[-1].copy(), "pinned": np.concatenate(bandrows)}
-    sizes = {"waist_girth": _circumference(waist), "length": float(z_w - z_hem),
-             "hem_girth": _circumference(np.concatenate(b.x)[rows[-1]]), "columns": N}
+    sizes = {"waist_girth": BF.circumference(waist), "length": float(z_w - z_hem),
+             "hem_girth": BF.circumference(np.concatenate(b.x)[rows[-1]]), "columns": N}
     return _finish(name, b, surface, fabric, fit, groups,
                    [(_ring_edges(bandrows), fit.elastic)], sizes)
 
