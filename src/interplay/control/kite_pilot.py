@@ -48,21 +48,22 @@ MANOEUVRES = ("hold", "loop", "figure8")
 class StuntPilotParams:
     """manoeuvre: hold | loop | figure8; start (s): when the first manoeuvre begins; every (s):
     the time from one manoeuvre's start to the next; ready (deg): the elevation a loop starts
-    from; target (deg): the azimuth held between
-    manoeuvres; gain (-): heading per azimuth error when holding; hold_tilt (deg): the
-    largest heading used to hold; hold_limit (-): the largest steering used to hold (a
-    full pull on one side leaves the other line slack); turn_gain (1/rad): steering per heading error; turn_damping
-    (s/rad): steering per error in the heading's rate of turn, so the nose settles; period
-    (s): the commanded time of one loop (its heading turns at 2 pi / period); feed (-): the
-    steady steering held on the inner side through a turn; throw (m): handle travel at full
-    steering (the difference between the hands is twice it); outer (-): the share of the
-    throw the outer hand gives forward (0: the inner hand pulls back the whole difference and
-    the outer holds, so the outer line stays taut; 1: both hands move alike); brace (m): both handles drawn back during a manoeuvre (a flyer leans back in a
-    turn, keeping both lines taut); lead (s): a turn is let go this long before the nose
-    completes its circle at the present rate of turn (the arms and the kite lag the hands);
-    slack (m/s): the kite coming towards the hands faster than this is a line going slack,
-    and the pilot steps back; step_in_turn: step back through every turn too; home_speed (m/s): how fast it walks back to its place while
-    the kite pulls; rate (Hz): how often the pilot looks and acts."""
+    from; target (deg): the azimuth held between manoeuvres; gain (-): heading per azimuth
+    error when holding; hold_tilt (deg): the largest heading used to hold; hold_limit (-):
+    the largest steering used to hold (a full pull on one side leaves the other line slack);
+    turn_gain (1/rad): steering per heading error; turn_damping (s/rad): steering per error
+    in the heading's rate of turn, so the nose settles; period (s): the commanded time of one
+    loop (its heading turns at 2 pi / period); feed (-): the steady steering held on the
+    inner side through a turn; throw (m): handle travel at full steering (the difference
+    between the hands is twice it); outer (-): the share of the throw the outer hand gives
+    forward (0: the inner hand pulls back the whole difference and the outer holds, so the
+    outer line stays taut; 1: both hands move alike); brace (m): both handles drawn back
+    during a manoeuvre (a flyer leans back in a turn, keeping both lines taut); lead (s): a
+    turn is let go this long before the nose completes its circle at the present rate of
+    turn (the arms and the kite lag the hands); slack (m/s): the kite coming towards the
+    hands faster than this is a line going slack, and the pilot steps back; step_in_turn:
+    step back through every turn too; home_speed (m/s): how fast it walks back to its place
+    while the kite pulls; rate (Hz): how often the pilot looks and acts."""
     manoeuvre: str = param("loop", "-", choices=MANOEUVRES)
     start: float = param(8.0, "s", ge=0.0, le=1e5)
     every: float = param(12.0, "s", gt=0.0, le=1e5)

@@ -1,11 +1,11 @@
-"""Single-line kites (SPEC 4, the kites row): three kites of different shapes and sizes, a flat
-diamond with a long tail of bows, a larger bowed diamond (the Eddy) and a rokkaku, each flown
-on its own line from a
-flyer's winder in the same gusty, turbulent wind that grows with height. Each kite is a cloth
-sail, a rigid frame, a bridle and line, and a tail, simulated separately and coupled two-way
-(``kite_parts``); the wind holds it up against the line's tension, the sail's ripple varies the
-forces on the frame, and the tail's drag steadies it: ``--set diamond_parts.tail.length=0``
-flies the diamond without its tail, and it loops and crashes (docs/kites.md). The flyers are
+"""Single-line kites (SPEC 4, the kites row): three kites of different shapes and sizes, a
+diamond (bowed 10 deg) with a long tail of bows, a larger bowed diamond (the Eddy) and a
+rokkaku, each flown on its own line from a flyer's winder in the same gusty, turbulent wind
+that grows with height. Each kite is a cloth sail, a rigid frame, a bridle and line, and a
+tail, simulated separately and coupled two-way (``kite_parts``); the wind holds it up against
+the line's tension, the sail's ripple varies the forces on the frame, and the tail's drag
+steadies it: ``--set diamond_parts.tail.length=0`` flies the diamond without its tail, and in
+the same gusts it wanders off and dives into the ground (docs/kites.md). The flyers are
 kinematic: they stand and hold their lines (one-way, in lock step with their kites).
 """
 from __future__ import annotations
