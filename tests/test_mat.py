@@ -129,3 +129,49 @@ def test_default_run_sticks_the_landing_and_depresses_the_mat(default_run):
     fig = M.landing_figures(default_run)
     assert fig["stuck"], fig
     assert 0.05 <= fig["mat depression (m)"] <= 0.2
+
+
+class _Here:
+    """An executor that evaluates a batch in this process (the search's own order): the
+    test's search is two evaluations, not worth a worker's start-up."""
+    kind, address, workers = "here", None, 1
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def map_unordered(self, fn, tasks):
+        for i, t in enumerate(tasks):
+            yield i, fn(t)
+
+
+def test_tune_mat_keeps_or_improves_the_landing_and_its_files_run(tmp_path):
+    """`interplay tune mat` (the landing search on the stand-in) with a budget of 2: the best
+    loss is at most the start's (the search keeps its best), the start's loss is the scene's
+    own controller, tune.json and the log are readable JSON, and
+    `run mat --controller tune.json` resolves to exactly the best values. About 5 s: two
+    1.9 s hybrid primary passes (1.9 s: the stick window needs 1 s after the 0.8 s
+    touch-down)."""
+    import json
+    from interplay.batch.tune import run_search
+    from interplay.batch.variants import RunRequest
+    from interplay.cli.controller import controller_sets
+    from interplay.control.landing_search import CLIP, LANDING
+    base = RunRequest("mat", None, (), 1.9)
+    doc = run_search(base, None, tmp_path, _Here(), budget=2, seed=3, chains=1,
+                     log=lambda line: None)
+    saved = json.loads((tmp_path / "tune.json").read_text())
+    lines = [json.loads(x) for x in (tmp_path / "evaluations.jsonl").read_text().splitlines()]
+    assert saved["best"] == doc["best"] and len(lines) == 2 == len(saved["history"])
+    assert saved["loss"] <= saved["start_loss"]
+    spec, coupling, kw = base.resolve()
+    # the search starts from the scene's own controller (its defaults)
+    assert saved["start"] == {k: getattr(kw["params"].vault, k.split(".")[1])
+                              for k in LANDING.bounds}
+    assert saved["start_loss"] == saved["history"][0][1] < 4 * CLIP + 1  # it landed
+    sets = controller_sets(spec, tmp_path / "tune.json")
+    _, _, tuned = RunRequest("mat", None, tuple(f"{k}={v}" for k, v in sets.items())).resolve()
+    for key, value in saved["best"].items():
+        assert getattr(tuned["params"].vault, key.split(".")[1]) == value

@@ -37,7 +37,6 @@ from ..systems.figure_model import EnvironmentParams
 from .bounce import BounceBalance, BounceParams
 from .fsm import Controller, State, Transition
 
-HOLD_BALANCE = (0.6, 0.25)  # rad/m, rad s/m: the figure's ankle strategy while she holds
 
 
 @dataclass(frozen=True)
@@ -53,9 +52,12 @@ class VaultParams:
     act on the whole body's inertia, so a critically damped one resists a fast flexion with
     kilonewtons and throws her back up) and time absorb (s); hold: arms_out (rad of shoulder
     abduction), knee_hold (rad); the balance over the feet on landing: k_lead (rad/m),
-    k_drift (rad s/m), k_spin (rad per kg m^2/s), k_attitude (-), and in the air k_speed
-    (s): the feet are placed ahead of the centre of mass by k_speed times its horizontal
-    speed."""
+    k_drift (rad s/m), k_spin (rad per kg m^2/s), k_attitude (-: the hip strategy, the
+    pelvis held upright over the legs), k_hip_spin (rad per kg m^2/s: the hips against the
+    body's pitch), and in the air k_speed (s): the feet are placed ahead of the centre of mass
+    by k_speed times its horizontal speed; hold_lead (rad/m), hold_drift (rad s/m): the
+    figure's ankle strategy in ``hold`` (ankles against the centre of mass's lead over the
+    feet and its speed)."""
     mass: float = param(64.38, "kg", ge=10.0, le=500.0)
     height: float = param(1.70, "m", ge=0.5, le=3.0)
     table: float = param(1.25, "m", ge=0.0, le=5.0, doc="vault table height")
@@ -82,6 +84,9 @@ class VaultParams:
     k_drift: float = param(0.2617214836251076, "rad s/m", ge=0.0, le=20.0)
     k_spin: float = param(0.01, "rad s/(kg m^2)", ge=0.0, le=1.0)
     k_attitude: float = param(0.0, "-", ge=0.0, le=3.0)
+    k_hip_spin: float = param(0.0, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    hold_lead: float = param(0.6, "rad/m", ge=0.0, le=20.0, doc="hold: ankles on the lead")
+    hold_drift: float = param(0.25, "rad s/m", ge=0.0, le=20.0, doc="hold: on its speed")
     k_speed: float = param(0.11655555301703205, "s", ge=0.0, le=5.0)
 
 
@@ -110,7 +115,7 @@ def controller(p: VaultParams) -> Controller:
                                ("knee", p.knee_hold), ("ankle", 0.5 * p.knee_hold),
                                ("waist", 0.0), ("neck", 0.0), ("shoulder_flex", 0.0),
                                ("shoulder_abd", p.arms_out), ("elbow", 0.1), ("toe", 0.0)),
-                 support=True, balance=HOLD_BALANCE, blend=0.6)
+                 support=True, balance=(p.hold_lead, p.hold_drift), blend=0.6)
     return Controller((flight, prepare, touchdown, hold), start="flight")
 
 
@@ -124,7 +129,7 @@ class LandingBalance(BounceBalance):
     def __init__(self, p: VaultParams, joints):
         bp = BounceParams(k_speed=p.k_speed, k_place=0.0, k_lead=p.k_lead, k_drift=p.k_drift,
                           k_spin=p.k_spin, k_attitude=p.k_attitude, k_turn=0.0,
-                          k_hip_spin=0.0, k_arms=0.0)
+                          k_hip_spin=p.k_hip_spin, k_arms=0.0)
         super().__init__(bp, joints)
 
     def offsets(self, fig, sensors) -> np.ndarray:

@@ -1,0 +1,61 @@
+"""The search for the vault's landing controller (``interplay tune mat``; SPEC 2.3, issue 17).
+
+The paper's point about the landing: her controller is tuned on the fast primary pass, her
+feet on the stand-in's vertical springs (hybrid), never on the slow two-way mat. A trial is
+that pass (the scene's coupling, hybrid by default: the primary pass only) of the whole
+landing, scored by how far it is from a stuck landing by the scene's own stick measures
+(scenes/landing_measures.stuck: over the last part of the run, from 1 s after touch-down,
+the centre of mass's horizontal speed, its distance from over the feet, the pelvis's tilt,
+and how far the soles moved after touch-down): each as a share of its threshold (clipped at
+CLIP, so a fall counts as a fall however far she rolls), plus 1 while any is past its
+threshold. A stuck landing scores under 4; the lower, the more margin it has.
+
+The search varies the landing controller only (``BOUNDS``: the prepare, absorption and hold
+postures and gains, the balance feedback), not the take-off, which is the vault's.
+"""
+from __future__ import annotations
+
+from .search import Search
+
+CLIP = 10.0  # -: a measure past 10 times its threshold is a fall, whatever its size
+
+#: the landing controller's parameters the search varies (VaultParams fields), (lo, hi) in
+#: their units; wide enough to hold every controller found by hand and by search so far
+BOUNDS = {"prepare_at": (0.6, 2.0), "spot": (0.0, 0.2), "hip_prepare": (0.0, 1.2),
+          "knee_prepare": (0.1, 1.2), "ankle_prepare": (-0.6, 0.3),
+          "hip_absorb": (0.4, 1.8), "knee_absorb": (0.6, 2.0), "ankle_absorb": (0.0, 0.8),
+          "absorb_omega": (3.0, 14.0), "absorb_zeta": (0.2, 1.5), "absorb": (0.2, 0.9),
+          "knee_hold": (0.0, 0.8), "k_lead": (0.0, 4.0), "k_drift": (0.0, 1.5),
+          "k_spin": (0.0, 0.1), "k_attitude": (0.0, 1.0), "k_hip_spin": (-0.1, 0.1),
+          "k_speed": (0.0, 0.4), "hold_lead": (0.0, 3.0), "hold_drift": (0.0, 1.5)}
+
+
+def stick_loss(figures: dict) -> float:
+    """The loss of a landing from its stick measures (``landing_measures.stuck``'s dict): the
+    sum of each measure over its threshold (clipped at CLIP), plus 1 unless stuck; 4 CLIP + 1
+    when the run ended before the measures' window (no touch-down, or too short)."""
+    from ..scenes.landing_measures import STICK
+    names = {"speed": "speed from 1 s after touch-down (m/s)",
+             "lead": "centre of mass off the feet (m)", "tilt": "pelvis tilt (rad)",
+             "moved": "feet moved after touch-down (m)"}
+    if not all(n in figures for n in names.values()):
+        return 4 * CLIP + 1.0
+    loss = sum(min(figures[n] / STICK[k], CLIP) for k, n in names.items())
+    return float(loss + (0.0 if figures["stuck"] else 1.0))
+
+
+def landing_loss(coupling: str, kw: dict) -> float:
+    """The search's loss (module-level, so a worker can import it): the scene built with the
+    keywords ``kw`` (params, duration, fps, ...) in ``coupling``, run (hybrid or one-way: the
+    primary pass only, her on the stand-in), scored by ``stick_loss``."""
+    from ..scenes.landing_measures import stuck
+    from ..scenes.mat import build
+    scene = build(coupling, **kw)
+    result = scene.simulate(primary_only=coupling != "two-way")
+    return stick_loss(stuck(result.frames["gymnast"]))
+
+
+LANDING = Search(
+    "landing", "the landing controller on the stand-in: stuck (still, over the feet, upright, "
+               "no step), with margin", bounds={f"vault.{k}": v for k, v in BOUNDS.items()},
+    loss=landing_loss, budget=120, chains=4, t_start=2.0, t_end=0.02, step=0.12)
