@@ -56,20 +56,22 @@ def impactor_body(p: Impactor, drop: float, top: float, centre) -> RigidBody:
 
 def drop_test(mat: MatParams = MatParams(), drops=(0.5, 1.0, 1.5, 2.0),
               impactor: Impactor = Impactor(), seconds: float = 0.25,
-              contact: PartContactParams = PartContactParams(friction=1.0)) -> list[dict]:
+              contact: PartContactParams = PartContactParams(friction=1.0),
+              integrator: str = "explicit", dt: float | None = None) -> list[dict]:
     """Drop ``impactor`` on the mat (at its centre) from each height in ``drops`` (m above
     its top); per drop: impact speed (m/s), the largest depression (m) of the mat's top under
     the base, the peak force (N) of the contact on the impactor (its largest substep force)
     and the mean force's peak (N, over 1 ms), the time to the deepest point (s) and the
     rebound speed (m/s, the impactor's upward speed when it leaves the mat, 0 if it has not
-    left it by ``seconds``)."""
+    left it by ``seconds``). integrator, dt (s): the mat's (default: the scene's explicit
+    step)."""
     from .mat import mat_network
     out = []
     x0, x1, y0, y1 = mat.footprint()
     centre = (0.5 * (x0 + x1), 0.5 * (y0 + y1))
     for drop in drops:
         scene = Scene("mat-impact", duration=seconds, fps=1000.0, coupling_dt=1e-3)
-        net = scene.add(mat_network(mat, "explicit"))
+        net = scene.add(mat_network(mat, integrator, dt))
         body = scene.add(impactor_body(impactor, drop, mat.thickness, centre))
         scene.connect(PartContact("impactor-mat", body, net, contact, mode="two-way",
                                   elements=net.top_edges))
