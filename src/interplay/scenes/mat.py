@@ -211,4 +211,5 @@ SPEC = SceneSpec(
     integrators=("explicit", "implicit"), standin="standin", fit=fit, figures=landing_figures,
     searches=(LANDING,),
     debug_ratio=5.0, contrast=contrast,
-    camera=Camera((1.9, -6.8, 2.0), (1.9, 0.0, 1.0), 45.0), key_time=0.83)
+    # heavy: each trial of its search flies the whole landing twice (seconds)
+    camera=Camera((1.9, -6.8, 2.0), (1.9, 0.0, 1.0), 45.0), key_time=0.83, heavy=True)
