@@ -198,3 +198,21 @@ def test_impactor_drop_deforms_the_mat_as_the_impact_tests_did():
         assert r["peak_force_N"] >= (0.5 * m * v * v + m * G * dep) / dep
         assert 0.0 <= r["rebound_m_s"] <= v
     assert d[0] < PUBLISHED[0] and PUBLISHED[0] <= d[2] <= PUBLISHED[1]
+
+
+def test_the_contact_meets_a_mirror_symmetric_top_face():
+    """The elements a foot collides with (the top face's edges and both diagonals of each
+    cell) map onto themselves under the mirror y -> -y and x -> (x0 + x1) - x: a landing
+    square on the mat loads both feet alike (one diagonal per cell did not: the right toes
+    took 9x the left's load). Exact: the lattice's points sit on a grid symmetric to
+    round-off, matched within 1e-9 m."""
+    from interplay.geometry.mat import build_mat
+    lat = build_mat(MatParams())
+    x = lat.x
+    x0, x1 = x[:, 0].min(), x[:, 0].max()
+    edges = {tuple(sorted(e)) for e in lat.top_edges.tolist()}
+    key = {tuple(np.round(p, 9)): i for i, p in enumerate(x)}
+    for flip in (np.array([1.0, -1.0, 1.0]), np.array([-1.0, 1.0, 1.0])):
+        shift = np.array([0.0, 0.0, 0.0]) if flip[0] > 0 else np.array([x0 + x1, 0.0, 0.0])
+        mirror = np.array([key[tuple(np.round(p * flip + shift, 9))] for p in x])
+        assert {tuple(sorted((mirror[a], mirror[b]))) for a, b in edges} == edges
