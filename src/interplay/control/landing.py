@@ -162,11 +162,7 @@ class LandingBalance(BounceBalance):
         want = 0.0
         if len(fig.feet_touching()):
             d = fig.data
-            R = d.xmat[fig.root].reshape(3, 3)
-            fwd = R[:, 0].copy()
-            fwd[2] = 0.0
-            fwd /= max(np.linalg.norm(fwd), 1e-9)
-            left = np.array([-fwd[1], fwd[0], 0.0])
+            _, left = fig.heading_axes()
             lead = (sensors["com"] - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ left
             want = float(np.clip(self.k_side * lead + self.k_side_drift * (sensors["com_vel"]
                                                                            @ left),
