@@ -10,6 +10,7 @@ from interplay.cli.command import main
 from interplay.coupling.modes import MODES
 from interplay.errors import InterplayError
 from interplay.geometry import shapes
+from interplay.outputs.rundata import load_run
 from interplay.scenes import all_specs, spec
 from interplay.systems.base import Role
 
@@ -188,6 +189,9 @@ def one_line_or_success(capsys, argv):
 def test_every_cli_verb_on_every_scene_exits_0_or_prints_one_line(name, tmp_path, capsys):
     out = str(tmp_path / name)
     assert one_line_or_success(capsys, ["run", name, "--out", out, *QUICK])[0] == 0
+    # the saved run reads back as the preview, view and sweep sheet read it
+    run = load_run(out)
+    assert {s.name for s in run.shapes if s.animated} <= set(run.frames)
     code, err = one_line_or_success(capsys, ["compare", name, "--out", out + "-cmp", *QUICK])
     assert (code == 0) == (len(spec(name).couplings) > 1)
     code, err = one_line_or_success(capsys, ["fit-standin", name, "--out", out, "--duration",

@@ -1,6 +1,8 @@
 """The owl-creek scene (Table I rows 3 and 4): the plank's swing, the figure's platform that
 opens, the noose's Table I row and its verdict, the noose holding him two-way and the
-constraint violation of one-way, the period of contact a row is measured over."""
+constraint violation of one-way, the period of contact a row is measured over; the vest's
+row and its one-way verdict, the vest staying on him, and (slow) how little a two-way vest
+changes his motion."""
 from dataclasses import replace
 
 import numpy as np
@@ -19,23 +21,38 @@ from interplay.systems.plank import HingedPlank, PlankParams  # noqa: E402
 G = 9.81
 OPENS = 1.0  # s: the scene's own stand (the noose settles on his shoulders)
 PAPER = PAPER_TABLE_I[("alien", "noose")]
+PAPER_VEST = PAPER_TABLE_I[("alien", "vest")]
 
 
-def _params(**noose):
+def _params(vest=False, **noose):
     p = OC.OwlCreekParams(opens=OPENS)
+    v = vest if not isinstance(vest, bool) else replace(p.vest, enabled=vest)
     return replace(p, drapes=replace(p.drapes, enabled=False),
-                   noose=replace(p.noose, **noose))
+                   noose=replace(p.noose, **noose), vest=v)
+
+
+def _run(mode, **kw):
+    res = OC.build(coupling=mode, duration=2.6, fps=100.0, params=_params(**kw)).simulate()
+    return res, OC.SPEC.figures(res)
 
 
 @pytest.fixture(scope="module")
 def runs():
     """The scene two-way and one-way (the drop at 1 s, 2.6 s in all: the jerk and the first
-    rebounds), the drapes left out."""
-    out = {}
-    for mode in ("two-way", "one-way"):
-        scene = OC.build(coupling=mode, duration=2.6, fps=100.0, params=_params())
-        res = scene.simulate()
-        out[mode] = (res, OC.SPEC.figures(res))
+    rebounds), the drapes and the vest left out."""
+    return {"two-way": _run("two-way"), "one-way": _run("one-way")}
+
+
+@pytest.fixture(scope="module")
+def vested():
+    """The two-way noose with the vest on him, one-way (the scene's choice) and two-way."""
+    on = replace(OC.OwlCreekParams().vest, enabled=True)
+    out = {"one-way": _run("two-way", vest=on),
+           "two-way": _run("two-way", vest=replace(on, coupling="two-way"))}
+    for mode, (res, fig) in out.items():  # the numbers docs/owl-creek.md quotes (pytest -s)
+        row = next(s for s in res.interaction_stats() if s["name"] == "vest")
+        print(f"vest {mode}: {row['force_N']} {row['acceleration_m_s2']} {fig} "
+              f"{res.warnings} {res.timings()['passes'][-1]}")
     return out
 
 
@@ -133,3 +150,90 @@ def test_one_way_noose_lets_him_fall_through(runs):
     assert fig["rope stretch max (%)"] / 100 > MANILA_BREAK_STRAIN
     assert fig["lowest centre of mass (m above the creek)"] < OC.DECK - 1.0
     assert res.advice_for(res.interaction("noose"))["mode"] == "two-way"
+
+
+def test_the_vest_is_cut_clear_of_him_at_the_papers_mass():
+    """The vest cut round his torso (no simulation): every point is farther from his torso
+    and pelvis boxes than its contact skin, the straps clear the noose's loop, its mass is
+    the paper's 0.5 kg, and its mesh is a manifold."""
+    from interplay.geometry import mesh as M
+    from interplay.scenes.owl_creek_parts import VEST_CONTACT
+    p = _params(vest=True)
+    scene = OC.build(duration=0.1, params=p)
+    vest = next(s for s in scene.systems if s.name == "vest")
+    M.validate(vest.x, vest.triangles, "vest")
+    fig = next(s for s in scene.systems if s.name == "alien")
+    view = fig.contact_view()
+    origin, R = view.poses()
+    gap = np.inf
+    for seg in ("torso", "pelvis"):
+        k = view.names.index(seg)
+        pr = view.primitives[k]
+        local = (vest.x - origin[k]) @ R[k] - np.asarray(pr.centre)
+        q = np.abs(local) - np.asarray(pr.axes)  # signed distance to the box
+        d = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
+        gap = min(gap, d.min())
+    assert gap > VEST_CONTACT.thickness
+    head = view.names.index("head")
+    up = R[head][:, 2]
+    radial = vest.x - origin[head]
+    radial -= np.outer(radial @ up, up)
+    near_neck = np.abs((vest.x - origin[head]) @ up) < 0.05
+    assert np.linalg.norm(radial[near_neck], axis=1).min() > p.noose.loop + OC.BAND
+    assert vest.m.sum() == pytest.approx(0.5, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_vest_row_against_table_one(vested):
+    """Table I's vest row within x2 of the paper's for the mean force and the mean
+    acceleration, measured from the one-way vest (its pull logged, not applied) from the drop
+    on; the accelerations are the forces over the alien's mass, exactly; the advisor says
+    one-way."""
+    res, _ = vested["one-way"]
+    row = next(s for s in res.interaction_stats() if s["name"] == "vest")
+    f, a = row["force_N"], row["acceleration_m_s2"]
+    assert row["mode"] == "one-way" and row["contact_s"][0] > OPENS
+    paper = PAPER_VEST["force_N"][2]
+    assert paper / 2 <= f["mean"] <= 2 * paper, (f["mean"], paper)
+    paper_a = PAPER_VEST["acceleration_m_s2"][2]
+    assert paper_a / 2 <= a["mean"] <= 2 * paper_a
+    for k in ("min", "max", "mean"):
+        assert a[k] == pytest.approx(f[k] / 46.56, rel=1e-12)
+    # hanging on his shoulders the vest's pull is at least its weight on average
+    assert f["mean"] >= 0.9 * 0.5 * G
+    assert res.advice_for(res.interaction("vest"))["mode"] == "one-way"
+
+
+@pytest.mark.xfail(strict=True, reason="issue 20's bar, not met: the vest's peak is ~4.6x the "
+                   "paper's 31.9 N; at the jerk his torso decelerates at ~150-200 m/s^2 and the "
+                   "vest on it with him (docs/owl-creek.md)")
+@pytest.mark.slow
+def test_vest_peak_force_within_twice_the_paper(vested):
+    res, _ = vested["one-way"]
+    row = next(s for s in res.interaction_stats() if s["name"] == "vest")
+    paper = PAPER_VEST["force_N"][1]
+    assert paper / 2 <= row["force_N"]["max"] <= 2 * paper
+
+
+@pytest.mark.slow
+def test_vest_stays_on_him(vested):
+    """Through the drop and the jerk the vest stays where it was put: it slides less than 3 cm
+    on him, goes at most 2 mm into him beyond its skin, and stretches less than a woven
+    fabric's ~15% break elongation, at its step without a torn pass rerun."""
+    res, fig = vested["one-way"]
+    assert not res.warnings
+    assert fig["vest slid on him max (m)"] < 0.03
+    assert fig["vest into the body max (mm)"] <= 2.0
+    assert fig["vest stretch max (%)"] < 15.0
+
+
+@pytest.mark.slow
+def test_a_two_way_vest_changes_his_motion_little(vested):
+    """Switching the vest to two-way moves his centre of mass by less than 1 cm at any frame
+    over the run (docs/owl-creek.md): a hundredth of his weight hanging on his shoulders;
+    one-way is the right choice, as the advisor says from either run."""
+    one, _ = vested["one-way"]
+    two, _ = vested["two-way"]
+    d = np.linalg.norm(two.frames["alien"]["com"] - one.frames["alien"]["com"], axis=1)
+    assert d.max() < 0.01
+    assert two.advice_for(two.interaction("vest"))["mode"] == "one-way"

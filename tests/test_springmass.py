@@ -139,6 +139,22 @@ def test_chain_rests_on_the_elastic_catenary():
     np.testing.assert_allclose(net.x[:, 0], xc, atol=2e-3 * sag)
 
 
+def test_a_remembered_sag_is_the_sag_of_that_network_only():
+    # settle remembers its result per network (compare's builds settle once): the same
+    # network again gets the same positions, bit for bit, and one spring stiffer a new sag
+    def chain(ea):
+        x0 = np.stack([np.linspace(0, 1, 11), np.zeros(11), np.zeros(11)], axis=1)
+        sp = Springs.from_ratio(x0, [(i, i + 1) for i in range(10)], ea)
+        net = SpringNetwork("chain", x0, np.full(11, 0.01), sp, integrator="implicit",
+                            dt=1e-3, fixed=[0, 10])
+        net.settle(seconds=0.5, h=5e-3, damping=5.0)
+        return net.x.copy()
+    first, again, stiffer = chain(20.0), chain(20.0), chain(40.0)
+    np.testing.assert_array_equal(first, again)
+    # the softer chain sags further: by about twice as much for this elastic sag
+    assert first[:, 2].min() < stiffer[:, 2].min() - 1e-3
+
+
 def test_explicit_step_above_bound_is_refused():
     with pytest.raises(StabilityError, match=r"explicit stability bound .* --integrator implicit"):
         oscillator(k=1e6, m=1e-3, integrator="explicit", dt=1e-3)

@@ -185,11 +185,7 @@ class BounceBalance:
 
     def offsets(self, fig, sensors) -> np.ndarray:
         d = fig.data
-        R = d.xmat[fig.root].reshape(3, 3)
-        fwd = R[:, 0].copy()
-        fwd[2] = 0.0
-        fwd /= max(np.linalg.norm(fwd), 1e-9)
-        left = np.array([-fwd[1], fwd[0], 0.0])
+        fwd, left = fig.heading_axes()
         p = self.p
         com, v = sensors["com"], sensors["com_vel"]
         want = np.zeros_like(self.out)
@@ -210,7 +206,7 @@ class BounceBalance:
         else:
             # in the air: place the feet ahead of the centre of mass to brake and steer back,
             # the hips turned against the pelvis's pitch and roll so the legs aim in the world
-            up = R[:, 2]
+            up = d.xmat[fig.root].reshape(3, 3)[:, 2]
             pitch = math.atan2(up @ fwd, up[2])  # pelvis leaning forward: > 0
             roll = math.atan2(-(up @ left), up[2])  # leaning to her right: > 0
             c = com[:2] - self.centre

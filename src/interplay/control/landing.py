@@ -37,7 +37,6 @@ from ..systems.figure_model import EnvironmentParams
 from .bounce import BounceBalance, BounceParams
 from .fsm import Controller, State, Transition
 
-HOLD_BALANCE = (0.6, 0.25)  # rad/m, rad s/m: the figure's ankle strategy while she holds
 
 
 @dataclass(frozen=True)
@@ -53,36 +52,48 @@ class VaultParams:
     act on the whole body's inertia, so a critically damped one resists a fast flexion with
     kilonewtons and throws her back up) and time absorb (s); hold: arms_out (rad of shoulder
     abduction), knee_hold (rad); the balance over the feet on landing: k_lead (rad/m),
-    k_drift (rad s/m), k_spin (rad per kg m^2/s), k_attitude (-), and in the air k_speed
-    (s): the feet are placed ahead of the centre of mass by k_speed times its horizontal
-    speed."""
+    k_drift (rad s/m), k_spin (rad per kg m^2/s), k_attitude (-: the hip strategy, the
+    pelvis held upright over the legs), k_hip_spin (rad per kg m^2/s: the hips against the
+    body's pitch), and in the air k_speed (s): the feet are placed ahead of the centre of mass
+    by k_speed times its horizontal speed; hold_lead (rad/m), hold_drift (rad s/m): the
+    figure's ankle strategy in ``hold`` (ankles against the centre of mass's lead over the
+    feet and its speed); k_side (rad/m), k_side_drift (rad s/m): the hip strategy sideways on
+    the ground (the hips ab/adducted together, shifting the pelvis over the feet against the
+    centre of mass's sideways lead over the middle of the soles and its sideways speed); vy
+    (m/s): a sideways take-off velocity (0 in the vault; the landing search perturbs it)."""
     mass: float = param(64.38, "kg", ge=10.0, le=500.0)
     height: float = param(1.70, "m", ge=0.5, le=3.0)
     table: float = param(1.25, "m", ge=0.0, le=5.0, doc="vault table height")
     com0: float = param(0.95, "m", ge=0.0, le=3.0, doc="centre of mass above the table")
     vx: float = param(3.3, "m/s", ge=-20.0, le=20.0, doc="horizontal take-off velocity")
     vz: float = param(2.5, "m/s", ge=-20.0, le=20.0, doc="vertical take-off velocity")
+    vy: float = param(0.0, "m/s", ge=-5.0, le=5.0, doc="sideways take-off velocity (left +)")
     pitch0: float = param(3.45, "rad", ge=-7.0, le=7.0, doc="trunk's turn from upright")
     spin: float = param(3.0505318143348936, "rad/s", ge=-30.0, le=30.0, doc="forward rotation")
-    prepare_at: float = param(1.289203401370083, "rad", ge=0.0, le=3.2)
-    spot: float = param(0.05, "s", ge=0.0, le=2.0)
-    hip_prepare: float = param(0.38, "rad", ge=-0.5, le=2.5)
-    knee_prepare: float = param(0.5553289705199036, "rad", ge=0.0, le=2.5)
-    ankle_prepare: float = param(-0.24664499792756536, "rad", ge=-1.0, le=1.0, doc="toes first")
+    prepare_at: float = param(1.688054306153082, "rad", ge=0.0, le=3.2)
+    spot: float = param(0.1410950340735813, "s", ge=0.0, le=2.0)
+    hip_prepare: float = param(0.4928070985665426, "rad", ge=-0.5, le=2.5)
+    knee_prepare: float = param(0.4943886615567404, "rad", ge=0.0, le=2.5)
+    ankle_prepare: float = param(-0.509549821061035, "rad", ge=-1.0, le=1.0, doc="toes first")
     arms_prepare: float = param(3.1, "rad", ge=-1.0, le=3.2)
-    hip_absorb: float = param(1.1602116944013092, "rad", ge=0.0, le=2.5)
-    knee_absorb: float = param(1.433029864950313, "rad", ge=0.0, le=2.5)
-    ankle_absorb: float = param(0.45966060729222497, "rad", ge=-0.5, le=1.0)
-    absorb_omega: float = param(6.4413535587524295, "rad/s", gt=0.0, le=100.0)
-    absorb_zeta: float = param(0.4226930255088814, "-", gt=0.0, le=10.0, doc="the absorption's damping")
-    absorb: float = param(0.4598196141367603, "s", ge=0.0, le=5.0)
+    hip_absorb: float = param(1.1036020539115974, "rad", ge=0.0, le=2.5)
+    knee_absorb: float = param(1.2296018642603024, "rad", ge=0.0, le=2.5)
+    ankle_absorb: float = param(0.3415375017295368, "rad", ge=-0.5, le=1.0)
+    absorb_omega: float = param(4.664790915968316, "rad/s", gt=0.0, le=100.0)
+    absorb_zeta: float = param(0.2970283853452195, "-", gt=0.0, le=10.0, doc="absorption damping")
+    absorb: float = param(0.2680534812830985, "s", ge=0.0, le=5.0)
     arms_out: float = param(1.4, "rad", ge=0.0, le=3.2)
-    knee_hold: float = param(0.26493408981094, "rad", ge=0.0, le=2.5)
-    k_lead: float = param(0.7378086688913733, "rad/m", ge=0.0, le=50.0)
-    k_drift: float = param(0.2617214836251076, "rad s/m", ge=0.0, le=20.0)
-    k_spin: float = param(0.01, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    knee_hold: float = param(0.20217419286080532, "rad", ge=0.0, le=2.5)
+    k_lead: float = param(0.45172797614368193, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.11509044357735548, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.00040150319502635893, "rad s/(kg m^2)", ge=0.0, le=1.0)
     k_attitude: float = param(0.0, "-", ge=0.0, le=3.0)
-    k_speed: float = param(0.11655555301703205, "s", ge=0.0, le=5.0)
+    k_hip_spin: float = param(0.006531532742935494, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    hold_lead: float = param(0.23293098267627355, "rad/m", ge=0.0, le=20.0, doc="hold: on the lead")
+    hold_drift: float = param(0.1750435213576305, "rad s/m", ge=0.0, le=20.0, doc="hold: on speed")
+    k_side: float = param(2.0257269278898433, "rad/m", ge=-20.0, le=20.0, doc="sideways hips")
+    k_side_drift: float = param(1.0991662049862119, "rad s/m", ge=-20.0, le=20.0, doc="on speed")
+    k_speed: float = param(0.0295218990763065, "s", ge=0.0, le=5.0)
 
 
 def controller(p: VaultParams) -> Controller:
@@ -110,27 +121,58 @@ def controller(p: VaultParams) -> Controller:
                                ("knee", p.knee_hold), ("ankle", 0.5 * p.knee_hold),
                                ("waist", 0.0), ("neck", 0.0), ("shoulder_flex", 0.0),
                                ("shoulder_abd", p.arms_out), ("elbow", 0.1), ("toe", 0.0)),
-                 support=True, balance=HOLD_BALANCE, blend=0.6)
+                 support=True, balance=(p.hold_lead, p.hold_drift), blend=0.6)
     return Controller((flight, prepare, touchdown, hold), start="flight")
+
+
+SIDE_MAX = 0.3  # rad: the largest sideways hip offset
+SIDE_RATE = 3.0  # rad/s: its fastest change (a shift, not a kick)
 
 
 class LandingBalance(BounceBalance):
     """The figure's feedback for a landing (the trampoline's balance law, control/bounce.py,
     reused): in the air, from ``prepare`` on, the feet are placed ahead of the centre of mass
     by k_speed times its speed; on the ground the ankles steer the centre of mass over the feet
-    and the hips hold the pelvis upright over the legs. Nothing while she turns over in
-    ``flight`` (the placement's angles mean nothing upside down)."""
+    and the hips hold the pelvis upright over the legs, and (its own) shift it sideways over
+    the feet (k_side, k_side_drift). Nothing while she turns over in ``flight`` (the
+    placement's angles mean nothing upside down)."""
 
     def __init__(self, p: VaultParams, joints):
         bp = BounceParams(k_speed=p.k_speed, k_place=0.0, k_lead=p.k_lead, k_drift=p.k_drift,
                           k_spin=p.k_spin, k_attitude=p.k_attitude, k_turn=0.0,
-                          k_hip_spin=0.0, k_arms=0.0)
+                          k_hip_spin=p.k_hip_spin, k_arms=0.0)
         super().__init__(bp, joints)
+        self.k_side, self.k_side_drift = p.k_side, p.k_side_drift
+        self.side = 0.0  # rad: the sideways hip offset now
+
+    def capture(self) -> dict:
+        return dict(super().capture(), side=np.array(self.side))
+
+    def restore(self, snap: dict):
+        super().restore(snap)
+        if snap:
+            self.side = float(snap["side"])
 
     def offsets(self, fig, sensors) -> np.ndarray:
         if fig.fsm.state.name == "flight":
             return self.out
-        return super().offsets(fig, sensors)
+        out = super().offsets(fig, sensors)
+        # sideways, on the ground: a symmetric stand-in never pushes her sideways, a mat's
+        # dent and a crooked take-off do; the hips shift the pelvis over the feet
+        want = 0.0
+        if len(fig.feet_touching()):
+            d = fig.data
+            _, left = fig.heading_axes()
+            lead = (sensors["com"] - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ left
+            want = float(np.clip(self.k_side * lead + self.k_side_drift * (sensors["com_vel"]
+                                                                           @ left),
+                                 -SIDE_MAX, SIDE_MAX))
+        step = SIDE_RATE * fig.control_dt
+        self.side = float(np.clip(want, self.side - step, self.side + step))
+        res = out.copy()
+        res[self.abd_l] += self.side
+        res[self.abd_r] -= self.side
+        return res
 
 
 def rotation_y(angle: float) -> np.ndarray:
@@ -159,7 +201,7 @@ def gymnast(p: VaultParams, floor: float | None, takeoff_x: float = 0.0,
     # the whole body turning at w about its centre of mass: the root moves at v + w x r
     w = np.array([0.0, p.spin, 0.0])
     r = d.qpos[:3] - fig.com()
-    d.qvel[:3] = np.array([p.vx, 0.0, p.vz]) + np.cross(w, r)
+    d.qvel[:3] = np.array([p.vx, p.vy, p.vz]) + np.cross(w, r)
     R = d.xmat[fig.root].reshape(3, 3)
     d.qvel[3:6] = R.T @ w  # MuJoCo's free joint: angular velocity in the body frame
     d.qvel[6:] = 0.0

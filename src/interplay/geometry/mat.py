@@ -82,7 +82,8 @@ class Lattice:
     """The built mat: positions (n,3) m, masses (n,) kg, springs (i, j, rest m, k N/m);
     kind (s,) 0 edge, 1 face diagonal, 2 body diagonal; bottom, top: indices of the bottom
     and top layers; triangles (t,3): the block's outer surface (drawn); top_edges (e,2): the
-    edges of the top face's triangles (what a foot collides with); shape (nx, ny, nz)."""
+    top face's edges and both diagonals of each of its cells (what a foot collides with:
+    mirror-symmetric, as the mat is); shape (nx, ny, nz)."""
     x: np.ndarray
     masses: np.ndarray
     i: np.ndarray
@@ -195,8 +196,14 @@ def build_mat(p: MatParams) -> Lattice:
     tris = np.concatenate([_grid_faces(idx[:, :, -1]), _grid_faces(idx[:, :, 0], True),
                            _grid_faces(idx[:, 0, :], True), _grid_faces(idx[:, -1, :]),
                            _grid_faces(idx[0, :, :]), _grid_faces(idx[-1, :, :], True)])
-    top_tris = _grid_faces(idx[:, :, -1])
-    e = np.sort(np.concatenate([top_tris[:, [0, 1]], top_tris[:, [1, 2]],
-                                top_tris[:, [2, 0]]]), axis=1)
+    # what a foot meets: every edge of the top face and both diagonals of each of its cells.
+    # One diagonal per cell (a triangulation) is not mirror-symmetric: measured, it loaded a
+    # landing's right toes 9 times the left ones and she fell sideways on a symmetric mat
+    t = idx[:, :, -1]
+    e = np.concatenate([np.stack([t[:-1, :].ravel(), t[1:, :].ravel()], 1),
+                        np.stack([t[:, :-1].ravel(), t[:, 1:].ravel()], 1),
+                        np.stack([t[:-1, :-1].ravel(), t[1:, 1:].ravel()], 1),
+                        np.stack([t[1:, :-1].ravel(), t[:-1, 1:].ravel()], 1)])
+    e = np.sort(e, axis=1)
     return Lattice(x, masses, ij[:, 0].copy(), ij[:, 1].copy(), rest, k, kind, bottom, top,
                    tris, np.unique(e, axis=0), (nx, ny, nz))

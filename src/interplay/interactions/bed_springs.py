@@ -14,7 +14,12 @@ a 0.3 m square (scenes/trampoline.load_deflection): not a spring's straight line
 bed hangs on horizontal springs and stiffens as it is pressed into a funnel (Kraft 2001).
 Tangentially the points cannot slide: a viscous force -friction_damping v per point against
 its horizontal velocity (a foot turning in the pocket drags its toes over the bed, as on the
-real one), capped at mu times the point's normal share. A stand-in has no mass,
+real one), capped at mu times the point's normal share; or, with ``eps`` > 0, the contact
+law's regularised Coulomb friction (kernels/contact_law.sliding_friction, the law the full
+rigid-parts contact applies on the network's side): mu times the normal share times
+min(1, |v_t| / eps), capped at the force that stops the point's slip within the coupling
+step (its share of the part's mass), so that the stand-in and the two-way contact hold a
+planted foot by the same law. A stand-in has no mass,
 no horizontal pull towards the bed's centre and no recoil lag of its own: what the two-way run
 adds is measured in docs/trampoline.md.
 """
@@ -36,7 +41,9 @@ class BedSpringsParams:
     """linear (N/m), quadratic (N/m^2), cubic (N/m^3): the bed's vertical force at depression
     D (``fit_curve``); damping (N s/m) of the depression rate; pocket (m): how far above the
     deepest point a support point still touches the bed; friction_damping (N s/m) per
-    point against sliding, friction (-) its cap over the normal share; enabled: false turns
+    point against sliding, friction (-) its cap over the normal share; eps (m/s): when > 0
+    the tangential law is the contact law's regularised Coulomb friction instead (full at
+    this slip speed; friction_damping is then unused); enabled: false turns
     the stand-in off (the hybrid primary then falls freely)."""
     # fitted to BedParams() (docs/trampoline.md)
     linear: float = param(1953.0, "N/m", ge=0.0, le=1e7)
@@ -46,6 +53,8 @@ class BedSpringsParams:
     pocket: float = param(0.05, "m", ge=0.0, le=1.0)
     friction_damping: float = param(200.0, "N s/m", ge=0.0, le=1e6)
     friction: float = param(0.8, "-", ge=0.0, le=10.0)
+    eps: float = param(0.0, "m/s", ge=0.0, le=10.0,
+                       doc="> 0: the contact law's Coulomb friction, full at this slip")
     enabled: bool = param(True, doc="false: the hybrid primary falls freely")
 
     def validated(self) -> "BedSpringsParams":
@@ -95,9 +104,10 @@ class BedSprings(StandIn):
 
     name = "bed springs"
 
-    def __init__(self, params: BedSpringsParams, body, surface: float):
+    def __init__(self, params: BedSpringsParams, body, surface: float, step: float = 1e-3):
         self.p = params.validated()
         self.surface = float(surface)  # m: the resting bed's top, where the springs begin
+        self.step = float(step)  # s: the coupling step the force is held for (eps > 0)
         view = body.contact_view()
         pts, rad, part = [], [], []
         for j, prim in enumerate(view.primitives):
@@ -110,6 +120,7 @@ class BedSprings(StandIn):
         self.local = np.concatenate(pts)
         self.radius = np.concatenate(rad)
         self.part = np.concatenate(part)
+        self.masses = np.asarray(view.masses, float)
         self._zero = np.zeros(3)
 
     def act(self, body):
@@ -139,7 +150,15 @@ class BedSprings(StandIn):
         f[:, 2] = share
         vt = v[:, :2]
         speed = np.linalg.norm(vt, axis=1)
-        cap = np.minimum(p.friction_damping, p.friction * share / np.maximum(speed, 1e-12))
+        if p.eps > 0.0:
+            # the contact law's friction (kernels/contact_law.sliding_friction), with each
+            # point's share of its part's mass as the effective mass of the cap
+            m = self.masses[part] / np.bincount(slot)[slot]
+            fmag = np.minimum(p.friction * share * np.minimum(1.0, speed / p.eps),
+                              m * speed / self.step)
+            cap = fmag / np.maximum(speed, 1e-12)
+        else:
+            cap = np.minimum(p.friction_damping, p.friction * share / np.maximum(speed, 1e-12))
         f[:, :2] = -cap[:, None] * vt
         tau = np.cross(r, f)
         for j in touched:

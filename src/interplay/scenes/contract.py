@@ -24,9 +24,11 @@ class SceneSpec:
     the moment its figure shows (the ball in the net), the gallery's still; figures: result ->
     {label: value}, the scene's own key figures (the basketball's exit speed) for summaries
     and compare tables; searches: the ``control.search.Search``es ``interplay tune`` can run
-    on it (the first is the default); heavy: its build alone takes tens of seconds (the
-    runner cuts and dresses garments), so the every-scene tests that build it many times
-    (the fuzz, every CLI verb) run it only in the slow suite; fit: (spec, params, **build
+    on it (the first is the default); heavy: its build or each trial of its search takes
+    seconds (the runner cuts and dresses garments; the diver flies his dive against still
+    water, a different dive for each fuzzed parameter; a trampoline bounce trial), so the
+    every-scene tests that build it many times (the fuzz, every CLI verb) run it only in the
+    slow suite, its own tests covering it in the default one; fit: (spec, params, **build
     keywords) -> report, a scene's own stand-in fit for ``fit-standin`` instead of matching
     the velocity at fit_time (the mat's: its curve to the mat's load-deflection; the report's
     "sets" are the fitted --set lines); debug_ratio: its primary is tuned by hand, so

@@ -25,6 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..control.landing import VaultParams, gymnast
+from ..control.landing_search import LANDING
 from ..errors import SceneError
 from ..geometry.anthropometry import SEGMENTS
 from ..geometry.mat import FEET_HALF, MAT_COLOR, MatParams, build_mat
@@ -56,11 +57,13 @@ class MatSceneParams:
     mat: MatParams = MatParams()
     vault: VaultParams = VaultParams()
     contact: PartContactParams = PartContactParams(friction=1.0)
-    # fitted to MatParams() by `interplay fit-standin mat` (docs/mat.md)
+    # fitted to MatParams() by `interplay fit-standin mat` (docs/mat.md); tangentially the
+    # contact's own friction law (mu and eps as ``contact``: docs/mat.md, the stand-in)
     standin: BedSpringsParams = BedSpringsParams(linear=60774.1, quadratic=148032.0,
                                                  cubic=1146180.0,
                                                  damping=300.0, pocket=0.03,
-                                                 friction_damping=2000.0, friction=1.0)
+                                                 friction_damping=2000.0, friction=1.0,
+                                                 eps=0.01)
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
     air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
 
@@ -192,7 +195,8 @@ def build(coupling: str = "hybrid", duration: float = 2.2, fps: float = 60.0,
     if mp.enabled:
         net = scene.add(mat_network(mp, integrator or "explicit", dt))
         # the stand-in's springs begin where the resting mat's top is, plus the skin
-        standin = BedSprings(params.standin, fig, top + params.contact.thickness)
+        standin = BedSprings(params.standin, fig, top + params.contact.thickness,
+                             params.coupling_dt)
         scene.connect(PartContact("gymnast-mat", fig, net, params.contact, mode=coupling,
                                   standin=standin, elements=net.top_edges))
         scene.main = "gymnast-mat"
@@ -205,5 +209,7 @@ SPEC = SceneSpec(
            "the mat, then her motion drives it (hybrid)", build, MatSceneParams,
     couplings=("hybrid", "two-way", "one-way"), duration=2.2, fps=60.0,
     integrators=("explicit", "implicit"), standin="standin", fit=fit, figures=landing_figures,
+    searches=(LANDING,),
     debug_ratio=5.0, contrast=contrast,
-    camera=Camera((1.9, -6.8, 2.0), (1.9, 0.0, 1.0), 45.0), key_time=0.83)
+    # heavy: each trial of its search flies the whole landing twice (seconds)
+    camera=Camera((1.9, -6.8, 2.0), (1.9, 0.0, 1.0), 45.0), key_time=0.83, heavy=True)

@@ -1,18 +1,23 @@
-"""The owl-creek scene's other pieces: the drapes in the breeze behind the condemned, and the
-measures of the noose (its stretch against manila's range, how deep it pressed into him,
+"""The owl-creek scene's other pieces: the vest he wears, the drapes in the breeze behind him,
+and the measures of the noose (its stretch against manila's range, how deep it pressed into him,
 whether the loop held, and whether a one-way run let him fall through it)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..geometry import shapes
 from ..geometry.anthropometry import SEGMENTS
+from ..geometry.garment import FABRICS, Garment
 from ..geometry.setpieces import merge, rod
+from ..geometry.vest import VestParams, vest_mesh
 from ..interactions.aero import AeroParams, Aerodynamics
+from ..interactions.part_contact import PartContact, PartContactParams
+from ..outputs.geometry import quat_rotate
 from ..params import param
 from ..systems.colliders import StaticMesh
+from ..systems.garments import spring_set
 from ..systems.springmass import SpringNetwork
 from .flags import FlagParams, GustyWind, wind_field
 
@@ -32,6 +37,44 @@ class DrapeParams:
                                    stretch=150.0, shear=50.0, bend=0.5)  # curtain cotton
     wind: GustyWind = GustyWind(speed=1.5, heading=0.0, gust=0.6, gust_period=3.0, cross=0.5)
     top: float = param(2.3, "m", ge=0.1, le=10.0, doc="the rod above the deck")
+
+
+#: the vest against his torso: a thin skin (the fabric's ~2 mm), wool on cloth friction
+VEST_CONTACT = PartContactParams(thickness=0.002, friction=0.5, contact_steps=3.0)
+
+
+def vest(scene, fig, p: VestParams, opens: float):
+    """Dress the figure in the vest (geometry/vest.py), cut round his torso and pelvis boxes
+    where they stand now, and connect it to all his parts (his arms brush it) by the
+    rigid-parts contact in ``p.coupling``; its mass is the paper's, spread by area (an areal
+    density of ~2.1 kg/m^2: a heavy lined vest with its buttons and pockets), its fabric's
+    stiffness scaled by the same factor.
+    Its measures: ``vest_figures``."""
+    if not p.enabled:
+        return None
+    view = fig.contact_view()
+    origin, R = view.poses()
+    t, pv = SEGMENTS.index("torso"), SEGMENTS.index("pelvis")
+    tp, pp = view.primitives[t], view.primitives[pv]
+    pelvis_c = R[t].T @ (origin[pv] + R[pv] @ np.asarray(pp.centre) - origin[t])
+    top = tp.centre[2] + tp.axes[2]
+    x, tris = vest_mesh(p, (tp.centre, tp.axes), (pelvis_c, pp.axes), top)
+    x = origin[t] + x @ R[t].T
+    area = 0.5 * float(np.linalg.norm(np.cross(x[tris[:, 1]] - x[tris[:, 0]],
+                                               x[tris[:, 2]] - x[tris[:, 0]]), axis=1).sum())
+    f = FABRICS[p.fabric]
+    scale = p.mass / area / f.density  # as stiff per kg/m^2 as its fabric
+    cloth = replace(f, name=f"vest of {f.name}", density=p.mass / area,
+                    tensile=scale * f.tensile, shear=scale * f.shear,
+                    bending=scale * f.bending, thickness=VEST_CONTACT.thickness)
+    springs, _, masses = spring_set(Garment("vest", x, tris, cloth))
+    net = scene.add(SpringNetwork("vest", x, masses, springs, dt=p.dt, integrator="implicit",
+                                  cg_tolerance=p.cg_tolerance, mass_damping=0.5,
+                                  stiffness_damping=p.damping, triangles=tris,
+                                  color=(0.36, 0.20, 0.12)))  # a brown wool
+    it = scene.connect(PartContact("vest", fig, net, VEST_CONTACT, mode=p.coupling))
+    it.period_from = opens  # Table I's row, as the noose's: from the drop on
+    return it
 
 
 def drapes(scene, p: DrapeParams, deck: float, edge: float):
@@ -92,6 +135,28 @@ def rope_figures(result) -> dict:
     else:
         out["constraint"] = "held: the rope stopped the fall within manila's stretch"
     return out
+
+
+def vest_figures(result) -> dict:
+    """The vest's measures: its largest stretch, the deepest it went into him (mm, beyond its
+    skin) and how far it slid on him over the run (m: its centre in his torso's frame)."""
+    if "vest" not in result.frames or "alien" not in result.frames:
+        return {}
+    it, body, t = result.interaction("vest"), result.frames["alien"], SEGMENTS.index("torso")
+    # the vest's centre in his torso's frame (he tilts as he hangs), against where it began
+    conj = body["segment_orientations"][:, t] * [1.0, -1.0, -1.0, -1.0]
+    on_him = quat_rotate(conj, result.frames["vest"]["points"].mean(axis=1)
+                         - body["segment_positions"][:, t])
+    slid = np.linalg.norm(on_him - on_him[0], axis=1)
+    return {"vest stretch max (%)":
+            100.0 * float(result.diagnostics.get("vest", {}).get("max_strain", 0.0)),
+            "vest into the body max (mm)": 1000.0 * float(it.get("deepest_m", 0.0)),
+            "vest slid on him max (m)": float(slid.max())}
+
+
+def figures(result) -> dict:
+    """The scene's key figures: the noose's and the vest's."""
+    return {**rope_figures(result), **vest_figures(result)}
 
 
 def _ring_size(result) -> int:

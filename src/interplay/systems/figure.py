@@ -295,6 +295,12 @@ class Figure(System, RigidParts):
         fwd[2] = 0.0
         return fwd / max(np.linalg.norm(fwd), 1e-9)
 
+    def heading_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(forward, left): the pelvis's facing and its left in the horizontal plane (unit),
+        the axes balance feedback works along."""
+        fwd = self._forward()
+        return fwd, np.array([-fwd[1], fwd[0], 0.0])
+
     def _control(self, t):
         if self.fsm is not None:
             s = self.sensors()
