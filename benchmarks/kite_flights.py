@@ -5,6 +5,7 @@ kite came down, each line's taut share). Writes DIR/kite_flights.json; nothing p
 fails here (the tests assert the physics; this records what the scenes do).
 
     .venv/bin/python benchmarks/kite_flights.py --out out/bench [--seeds 10] [--quick]
+        [--only single|stunt] [--stunt-duration 36]
 """
 from __future__ import annotations
 
@@ -39,15 +40,42 @@ def stunt(manoeuvre, seed, duration):
 
 
 def main():
-    a, _ = parse_args(__doc__, lambda ap: ap.add_argument("--seeds", type=int, default=10))
+    def more(ap):
+        ap.add_argument("--seeds", type=int, default=10)
+        ap.add_argument("--only", choices=("single", "stunt"), default=None)
+        ap.add_argument("--stunt-duration", type=float, default=36.0)
+    a, _ = parse_args(__doc__, more)
     long = 30.0 if a.quick else 130.0
     seeds = range(2 if a.quick else a.seeds)
-    out = {"machine": machine(),
-           "single": single(long),
-           "diamond_without_tail": single(60.0 if not a.quick else 30.0,
-                                          {"diamond_parts.tail.length": "0"}),
-           "stunt": {m: [stunt(m, s, 36.0) for s in seeds] for m in ("loop", "figure8")}}
-    print(write_json(a.out, "kite_flights.json", out))
+    out = {"machine": machine()}
+    if a.only != "stunt":
+        out["single"] = single(long)
+        out["diamond_without_tail"] = single(60.0 if not a.quick else 30.0,
+                                             {"diamond_parts.tail.length": "0"})
+    if a.only != "single":
+        out["stunt"] = {m: [stunt(m, s, a.stunt_duration) for s in seeds]
+                        for m in ("loop", "figure8")}
+        out["stunt_summary"] = summary(out["stunt"])
+    print(write_json(a.out, f"kite_flights{'_' + a.only if a.only else ''}.json", out))
+
+
+def summary(runs):
+    """Per manoeuvre over the seeds: how many completed their first manoeuvre, how many in
+    4 s or less (a loop), how many stayed up, and the lines' taut shares (min, median)."""
+    import numpy as np
+    out = {}
+    for m, rs in runs.items():
+        first = [next((v for k, v in r["figures"].items() if k.startswith(m + " 1")), None)
+                 for r in rs]
+        taut = [min(r["figures"].get("l_handle taut share", 0.0),
+                    r["figures"].get("r_handle taut share", 0.0)) for r in rs]
+        out[m] = {"seeds": len(rs), "completed": sum(f is not None for f in first),
+                  "in_4_s": sum(f is not None and f <= 4.0 for f in first),
+                  "stayed_up": sum(r["figures"].get("came down at s") is None for r in rs),
+                  "first_s": first, "taut_min_share": taut,
+                  "taut_95": sum(t >= 0.95 for t in taut),
+                  "taut_median": float(np.median(taut))}
+    return out
 
 
 if __name__ == "__main__":

@@ -12,16 +12,24 @@ machine over the flight):
   azimuth (heading -gain (phi - target), within +-hold_tilt) and the kite climbs to where it
   rests, the window's top over that azimuth;
 * ``loop``: from ``start`` (s), one loop every ``every`` seconds, to the left and the right by
-  turns, each begun once the kite is parked high (above ``ready`` deg of elevation): one side
-  is pulled fully until the nose has turned a full circle (the turn measured by integrating
-  the heading's change), then the kite is held again;
+  turns, each begun once the kite is parked high (above ``ready`` deg of elevation): the
+  pilot commands a heading that turns at 2 pi / ``period`` (rad/s) and steers by the error
+  between it and the nose's measured heading (feedback, plus a steady pull ``feed`` on the
+  inner side), until the nose has turned a full circle (the turn measured by integrating the
+  heading's change), then the kite is held again;
 * ``figure8``: a loop one way, the kite brought back up to where it began (``ready``), and a
   loop the other way: two circles meeting at the top of the window, an eight.
 
-The steering command u in [-1, 1] (positive: pull the left handle) moves the left handle back
-and the right one forward by u times ``throw`` (m) along the pilot's facing; the pilot's arms
-(``systems.pilot``) follow it with their own response time. The controller acts at
-``rate`` (Hz), a person's reaction cadence.
+The steering command u in [-1, 1] (positive: pull the left handle) sets a difference of 2 u
+``throw`` (m) between the hands along the pilot's facing: the inner hand pulls back, the
+outer gives forward only its share ``outer`` of it (a flyer pulls; letting a hand forward
+slackens that line, and a kite on one slack line turns the wrong way); during a
+manoeuvre both are drawn back by ``brace`` as well, so the outer line stays taut. The pilot's
+arms (``systems.pilot``) follow it with their own response time. A flyer takes up slack with
+the feet: whenever the kite comes towards the hands faster than ``slack`` (m/s: the line
+going slack) and through each turn, the pilot steps back (``Pilot``'s walk, at its walking
+speed), and walks home again at ``home_speed`` while the kite is held and pulling. The
+controller acts at ``rate`` (Hz), a person's reaction cadence.
 """
 from __future__ import annotations
 
@@ -40,15 +48,22 @@ MANOEUVRES = ("hold", "loop", "figure8")
 class StuntPilotParams:
     """manoeuvre: hold | loop | figure8; start (s): when the first manoeuvre begins; every (s):
     the time from one manoeuvre's start to the next; ready (deg): the elevation a loop starts
-    from; target (deg): the azimuth held between
-    manoeuvres; gain (-): heading per azimuth error when holding; hold_tilt (deg): the
-    largest heading used to hold; turn_gain (1/rad): steering per heading error; turn_damping
-    (s/rad): steering against the heading's rate of turn, so the nose settles; throw (m):
-    handle travel at full steering; brace (m): both handles drawn back during a manoeuvre (a
-    flyer leans back in a turn, keeping both lines taut); lead (s): a turn is let go this
-    long before the nose completes its circle at the present rate of turn (the arms and the
-    kite lag the hands); rate (Hz): how often the pilot looks
-    and acts."""
+    from; target (deg): the azimuth held between manoeuvres; gain (-): heading per azimuth
+    error when holding; hold_tilt (deg): the largest heading used to hold; hold_limit (-):
+    the largest steering used to hold (a full pull on one side leaves the other line slack);
+    turn_gain (1/rad): steering per heading error; turn_damping (s/rad): steering per error
+    in the heading's rate of turn, so the nose settles; period (s): the commanded time of one
+    loop (its heading turns at 2 pi / period); feed (-): the steady steering held on the
+    inner side through a turn; throw (m): handle travel at full steering (the difference
+    between the hands is twice it); outer (-): the share of the throw the outer hand gives
+    forward (0: the inner hand pulls back the whole difference and the outer holds, so the
+    outer line stays taut; 1: both hands move alike); brace (m): both handles drawn back
+    during a manoeuvre (a flyer leans back in a turn, keeping both lines taut); lead (s): a
+    turn is let go this long before the nose completes its circle at the present rate of
+    turn (the arms and the kite lag the hands); slack (m/s): the kite coming towards the
+    hands faster than this is a line going slack, and the pilot steps back; step_in_turn:
+    step back through every turn too; home_speed (m/s): how fast it walks back to its place
+    while the kite pulls; rate (Hz): how often the pilot looks and acts."""
     manoeuvre: str = param("loop", "-", choices=MANOEUVRES)
     start: float = param(8.0, "s", ge=0.0, le=1e5)
     every: float = param(12.0, "s", gt=0.0, le=1e5)
@@ -56,11 +71,18 @@ class StuntPilotParams:
     target: float = param(0.0, "deg", ge=-90.0, le=90.0)
     gain: float = param(2.0, "-", ge=0.0, le=100.0)
     hold_tilt: float = param(30.0, "deg", ge=0.0, le=90.0)
+    hold_limit: float = param(0.4, "-", ge=0.0, le=1.0)
     turn_gain: float = param(0.8, "1/rad", ge=0.0, le=100.0)
     turn_damping: float = param(0.3, "s/rad", ge=0.0, le=100.0)
+    period: float = param(3.5, "s", gt=0.0, le=100.0)
+    feed: float = param(1.0, "-", ge=0.0, le=1.0)
     throw: float = param(0.25, "m", ge=0.0, le=1.0)
-    brace: float = param(0.0, "m", ge=-1.0, le=1.0)
+    brace: float = param(0.1, "m", ge=-1.0, le=1.0)
     lead: float = param(0.2, "s", ge=0.0, le=5.0)
+    outer: float = param(1.0, "-", ge=0.0, le=1.0)
+    slack: float = param(0.5, "m/s", ge=0.0, le=20.0)
+    step_in_turn: bool = param(False, "-")
+    home_speed: float = param(0.3, "m/s", ge=0.0, le=5.0)
     rate: float = param(20.0, "Hz", gt=0.0, le=1000.0)
 
 
@@ -82,6 +104,9 @@ def heading(nose, phi, eps):
 
 HOLD, TURN, RECOVER = 0, 1, 2  # the pilot's phases: holding, turning a loop, climbing back
 SETTLED = math.radians(20.0)  # the nose is near enough straight up to begin a loop
+FLIP = math.radians(90.0)  # a turn's heading jumping back this far in one look flipped through
+LOW = (math.radians(15.0), math.radians(30.0))  # rad: below the first elevation the nose is
+# held straight up (climb first), above the second it may tilt by all of hold_tilt
 
 
 def _wrap(a):
@@ -107,6 +132,8 @@ class StuntPilot:
         self.turned = 0.0  # rad the nose has turned in the current turn
         self.last = None  # the heading at the last look
         self.phase = HOLD
+        self.since = 0.0  # time (s) the current turn began
+        self.back = 0.0  # m the pilot wants to stand back from its place
         self.side = 1  # the side (+1: the pilot's left) the manoeuvre is on now
         self.count = 0  # manoeuvres started
         self.log = []
@@ -125,30 +152,58 @@ class StuntPilot:
             self._decide(pilot, t)
         forward = pilot.R0[:, 0] * np.array([1.0, 1.0, 0.0])
         forward /= np.linalg.norm(forward)
-        off = self.u * self.p.throw * forward
-        back = (self.p.brace if self.phase != HOLD else 0.0) * forward
-        return pilot.rest + np.array([-off - back, off - back])
+        # the inner hand pulls back, the outer gives forward its share (outer) of the throw
+        inner = (2.0 - self.p.outer) * abs(self.u) * self.p.throw
+        outer = self.p.outer * abs(self.u) * self.p.throw
+        left, right = (inner, -outer) if self.u > 0 else (-outer, inner)
+        back = self.p.brace if self.phase != HOLD else 0.0
+        return pilot.rest - np.outer([left + back, right + back], forward)
+
+    def stance(self, pilot, t):
+        """How far (m) behind its place the pilot wants to stand (``Pilot`` walks there)."""
+        return self.back
+
+    def _closing(self, pilot):
+        """The kite's speed (m/s) towards the hands: a line going slack."""
+        pos, _ = self.kite.poses()
+        r = pos[0] - pilot.hx.mean(axis=0)
+        v = self.kite.velocities()[0][0] - pilot.hv.mean(axis=0)
+        return -float(v @ r) / max(float(np.linalg.norm(r)), 1e-9)
 
     def _decide(self, pilot, t):
         phi, eps, chi = self.observe(pilot.rest.mean(axis=0))
         rate = 0.0
         if self.last is not None:
             step = _wrap(chi - self.last)
+            if self.phase == TURN and self.side * step < -FLIP:
+                step += self.side * 2.0 * math.pi  # the nose flipped through, on in the turn
             self.turned += step
             rate = step / self.period
         self.last = chi
         p = self.p
+        # the feet: step back while a line goes slack or the kite turns, home while it pulls
+        walk = pilot.params.walk_speed * self.period
+        if self._closing(pilot) > p.slack or (self.phase != HOLD and p.step_in_turn):
+            self.back = min(pilot.back + walk, pilot.params.walk)
+        else:
+            self.back = max(pilot.back - p.home_speed * self.period, 0.0)
         ready = eps >= math.radians(p.ready) and abs(chi) < SETTLED
         if (self.phase == HOLD and p.manoeuvre != "hold" and ready
                 and t >= p.start + self.count * p.every):
             self.side = 1 if self.count % 2 == 0 else -1
             self.count += 1
             self.log.append([p.manoeuvre, self.side, t, None])
-            self.phase, self.turned = TURN, 0.0
+            self.phase, self.turned, self.since = TURN, 0.0, t
         elif self.phase == RECOVER and ready:  # the eight's second loop, the other way
-            self.side, self.phase, self.turned = -self.side, TURN, 0.0
+            self.side, self.phase, self.turned, self.since = -self.side, TURN, 0.0, t
         if self.phase == TURN:
-            self.u = float(self.side)
+            # the commanded heading turns at 2 pi / period; steer by the error from it
+            w = 2.0 * math.pi / p.period
+            want = min(w * (t - self.since), 2.0 * math.pi)
+            err = want - self.side * self.turned
+            self.u = float(np.clip(self.side * (p.feed + p.turn_gain * err
+                                                - p.turn_damping * (self.side * rate - w)),
+                                   -1.0, 1.0))
             ahead = max(0.0, self.side * rate) * p.lead
             if self.side * self.turned + ahead >= 2.0 * math.pi:
                 eight = p.manoeuvre == "figure8" and self.side == self.log[-1][1]
@@ -158,14 +213,16 @@ class StuntPilot:
         if (self.phase == HOLD and self.log and self.log[-1][3] is None
                 and self.side * self.turned >= 2.0 * math.pi):
             self.log[-1][3] = t  # the nose has come round a full circle: the loop is done
-        tilt = math.radians(p.hold_tilt)
+        tilt = math.radians(p.hold_tilt) * float(np.clip((eps - LOW[0]) / (LOW[1] - LOW[0]),
+                                                         0.0, 1.0))
         self._steer(float(np.clip(-p.gain * (phi - math.radians(p.target)), -tilt, tilt)),
                     chi, rate)
 
     def _steer(self, want, chi, rate):
         """Steer the nose towards heading ``want`` (rad), damped by its rate of turn."""
+        lim = self.p.hold_limit
         self.u = float(np.clip(self.p.turn_gain * _wrap(want - chi)
-                               - self.p.turn_damping * rate, -1.0, 1.0))
+                               - self.p.turn_damping * rate, -lim, lim))
 
     # --- memory, for checkpoints -----------------------------------------------------------------
     def capture(self) -> dict:
@@ -173,10 +230,12 @@ class StuntPilot:
                         for k, s, a, b in self.log]).reshape(-1, 4)
         return {"state": np.array([self.u, self.next, self.turned,
                                    np.nan if self.last is None else self.last,
-                                   self.phase, self.side, self.count]), "log": log}
+                                   self.phase, self.side, self.count, self.since,
+                                   self.back]), "log": log}
 
     def restore(self, snap: dict):
-        u, nxt, turned, last, phase, side, count = snap["state"]
+        u, nxt, turned, last, phase, side, count, since, back = snap["state"]
+        self.since, self.back = float(since), float(back)
         self.u, self.next, self.turned = float(u), float(nxt), float(turned)
         self.last = None if math.isnan(last) else float(last)
         self.phase, self.side, self.count = int(phase), int(side), int(count)

@@ -1,11 +1,11 @@
-"""Single-line kites (SPEC 4, the kites row): three kites of different shapes and sizes, a flat
-diamond with a long tail of bows, a larger bowed diamond (the Eddy) and a rokkaku, each flown
-on its own line from a
-flyer's winder in the same gusty, turbulent wind that grows with height. Each kite is a cloth
-sail, a rigid frame, a bridle and line, and a tail, simulated separately and coupled two-way
-(``kite_parts``); the wind holds it up against the line's tension, the sail's ripple varies the
-forces on the frame, and the tail's drag steadies it: ``--set diamond_parts.tail.length=0``
-flies the diamond without its tail, and it loops and crashes (docs/kites.md). The flyers are
+"""Single-line kites (SPEC 4, the kites row): three kites of different shapes and sizes, a
+diamond (bowed 10 deg) with a long tail of bows, a larger bowed diamond (the Eddy) and a
+rokkaku, each flown on its own line from a flyer's winder in the same gusty, turbulent wind
+that grows with height. Each kite is a cloth sail, a rigid frame, a bridle and line, and a
+tail, simulated separately and coupled two-way (``kite_parts``); the wind holds it up against
+the line's tension, the sail's ripple varies the forces on the frame, and the tail's drag
+steadies it: ``--set diamond_parts.tail.length=0`` flies the diamond without its tail, and in
+the same gusts it wanders off and dives into the ground (docs/kites.md). The flyers are
 kinematic: they stand and hold their lines (one-way, in lock step with their kites).
 """
 from __future__ import annotations
@@ -40,8 +40,11 @@ class KitesParams:
     """Each kite's design and components (its line's length among them); spacing (m): the
     flyers stand this far apart across the wind; launch_elevation (deg) and launch_alpha (deg):
     where each kite is let go, and its sail's angle to the wind then; coupling_dt (s)."""
-    wind: KP.KiteWind = KP.KiteWind(speed=6.0)
-    diamond: DiamondParams = DiamondParams(tow=0.31, dihedral=10.0)
+    # turbulence: the neutral surface layer's at 10 m over short grass (z0 = 0.03 m): sigma_u,
+    # sigma_v, sigma_w = 2.4, 1.9, 1.25 u* (Panofsky & Dutton 1984) with u = u* ln(z / z0) /
+    # 0.4, i.e. 16.5, 13 and 8.6% of the speed; the primitive is isotropic, so their rms, 13%
+    wind: KP.KiteWind = KP.KiteWind(speed=6.0, turbulence=0.13)
+    diamond: DiamondParams = DiamondParams(tow=0.295, dihedral=10.0)
     diamond_parts: KP.KiteParams = KP.KiteParams(
         tail=KP.TailParams(length=6.0, segments=24, bow_area=0.003))
     # the Eddy: its cross spar high up the spine and bowed back (Eddy, 1890s)

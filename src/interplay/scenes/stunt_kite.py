@@ -36,7 +36,7 @@ LAUNCH_ALPHA = 25.0  # deg: its sail's angle to the wind then, near how it flies
 class StuntKiteParams:
     """The kite's design, its components, the pilot and how it flies, the wind; coupling_dt
     (s): the step at which the components exchange forces."""
-    kite: StuntParams = StuntParams(dihedral=0.0, ballast=0.1, tow=0.36, tow_height=0.6,
+    kite: StuntParams = StuntParams(dihedral=0.0, ballast=0.15, tow=0.36, tow_height=0.6,
                                     spars=SparParams(radius=0.003, density=600.0))
     parts: KP.KiteParams = KP.KiteParams(
         line=KP.LineParams(radius=3e-4, density=3e-4),

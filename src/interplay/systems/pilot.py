@@ -36,7 +36,10 @@ class PilotParams:
     winder held in both hands); grip (m): the handles' rest position in the body frame (x
     forward, y half the spread between two handles, z height above the ground); reach (m):
     how far a handle may move from rest; response (s): the arms' time constant; lean (deg):
-    the body leaning back against the pull; mass (kg) and height (m) of the person."""
+    the body leaning back against the pull; mass (kg) and height (m) of the person; walk (m):
+    how far the flyer may step back from ``position`` (a controller asks for it with
+    ``stance``: a flyer takes up a line's slack by stepping back), at up to walk_speed
+    (m/s)."""
     position: tuple = param((0.0, 0.0, 0.0), "m")
     heading: float = param(0.0, "deg", ge=-360.0, le=360.0)
     handles: int = param(2, "-", ge=1, le=2)
@@ -46,6 +49,8 @@ class PilotParams:
     lean: float = param(6.0, "deg", ge=-45.0, le=45.0)
     mass: float = param(75.0, "kg", ge=10.0, le=500.0)
     height: float = param(1.75, "m", ge=0.5, le=3.0)
+    walk: float = param(4.0, "m", ge=0.0, le=50.0)
+    walk_speed: float = param(1.5, "m/s", gt=0.0, le=10.0)
 
 
 def _rotation(axis, angle):
@@ -113,6 +118,9 @@ class Pilot(System, RigidParts):
         gx, gy, gz = params.grip
         rows = [(gx, gy, gz), (gx, -gy, gz)] if params.handles == 2 else [(gx, 0.0, gz)]
         self.rest = self.base + np.array(rows) @ _rotation((0, 0, 1), h).T
+        self.facing = np.array([math.cos(h), math.sin(h), 0.0])
+        self.home = (self.base.copy(), self.rest.copy())  # where it stands before stepping
+        self.back = 0.0  # m stepped back from home, along -facing
         self.hx = self.rest.copy()  # handle positions (m) and velocities (m/s)
         self.hv = np.zeros_like(self.hx)
         self.target = self.rest.copy()
@@ -173,6 +181,11 @@ class Pilot(System, RigidParts):
         """Ask the controller for the handles' targets (kept within reach), move the handles
         towards them by the exact step of x'' = w^2 (target - x) - 2 w x' (w = 1 / response)
         for a target held over the step, and pose the arms."""
+        if self.controller is not None and hasattr(self.controller, "stance"):
+            want = min(max(float(self.controller.stance(self, self.time)), 0.0),
+                       self.params.walk)
+            move = self.params.walk_speed * h
+            self._stand(self.back + min(max(want - self.back, -move), move))
         if self.controller is not None:
             tgt = np.asarray(self.controller.targets(self, self.time), float)
             off = tgt - self.rest
@@ -194,6 +207,12 @@ class Pilot(System, RigidParts):
         for _ in range(n):
             self.step(h / n)
         self.time = t0 + h
+
+    def _stand(self, back: float):
+        """Stand ``back`` m behind home (the feet, the body and the handles' rest with them)."""
+        self.back = float(back)
+        self.base = self.home[0] - self.back * self.facing
+        self.rest = self.home[1] - self.back * self.facing
 
     def handle_positions(self) -> np.ndarray:
         """(k,3) m: where the handles are."""
@@ -242,19 +261,21 @@ class Pilot(System, RigidParts):
 
     # --- state ---------------------------------------------------------------------------------
     def generalized_state(self):
-        return (np.concatenate([self.hx.ravel(), self.target.ravel()]),
-                np.concatenate([self.hv.ravel(), np.zeros(self.target.size)]))
+        return (np.concatenate([self.hx.ravel(), self.target.ravel(), [self.back]]),
+                np.concatenate([self.hv.ravel(), np.zeros(self.target.size + 1)]))
 
     def set_generalized_state(self, x, xdot):
         k = self.hx.size
         self.hx[:] = np.reshape(x[:k], self.hx.shape)
-        self.target[:] = np.reshape(x[k:], self.target.shape)
+        self.target[:] = np.reshape(x[k:2 * k], self.target.shape)
+        if len(x) > 2 * k:
+            self._stand(float(x[2 * k]))
         self.hv[:] = np.reshape(xdot[:k], self.hv.shape)
         self._pose()
 
     def capture(self):
         snap = {"hx": self.hx.copy(), "hv": self.hv.copy(), "target": self.target.copy(),
-                "time": np.array(self.time)}
+                "time": np.array(self.time), "back": np.array(self.back)}
         if self.controller is not None:
             snap.update({f"controller_{k}": v for k, v in self.controller.capture().items()})
         return snap
@@ -262,6 +283,7 @@ class Pilot(System, RigidParts):
     def restore(self, snap):
         self.hx[:], self.hv[:], self.target[:] = snap["hx"], snap["hv"], snap["target"]
         self.time = float(snap["time"])
+        self._stand(float(snap.get("back", 0.0)))
         if self.controller is not None:
             self.controller.restore({k[len("controller_"):]: v for k, v in snap.items()
                                      if k.startswith("controller_")})
