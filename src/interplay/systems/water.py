@@ -276,7 +276,9 @@ class Water(System):
         c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
         # sand below the highest still water, turning to the banks' colour up to the rim
         wet = self.fluid & (self.V > 0.0)
-        level = float(np.max(np.where(wet, self.bed + self.V / self.area, -np.inf)))
+        # (a basin with no water in it, as a pass that never reads it may leave it: its floor)
+        level = (float(np.max(np.where(wet, self.bed + self.V / self.area, -np.inf)))
+                 if wet.any() else float(self.bed.min()))
         up = np.clip((bed.ravel() - level) / max(float(self.bed.max()) - level, 1e-3), 0.0,
                      1.0)[:, None]
         colors = (1 - up) * np.asarray(self.bed_color) + up * np.asarray(self.bank_color)
