@@ -14,6 +14,7 @@ from interplay.errors import SceneError  # noqa: E402
 from interplay.geometry.mat import MatParams  # noqa: E402
 from interplay.scenes import mat as M  # noqa: E402
 from contact_checks import equal_and_opposite_every_step  # noqa: E402
+from static_reference import rest_under_load  # noqa: E402
 
 G = 9.81
 H = 1e-3  # s, the coupling step
@@ -23,31 +24,12 @@ SMALL = MatParams(length=0.6, width=0.4, nx=7, ny=5, nz=3)  # 105 points: a stat
 def _static_solve(net, load):
     """A slow reference: the mat's rest under the load as the minimum of its potential energy
     (springs, gravity, the load) by L-BFGS from the unloaded block, bottom held."""
-    from scipy.optimize import minimize
     free = np.setdiff1d(np.arange(len(net.x)), net.bottom)
-    x0 = net.x.copy()
     sel = M.pressed_points(net)
-    f = np.zeros_like(x0)
+    f = np.zeros_like(net.x)
     f[sel, 2] = -load / len(sel)
     f[:, 2] -= net.m * G
-
-    def energy(u):
-        x = x0.copy()
-        x[free] = u.reshape(-1, 3)
-        d = x[net.si] - x[net.sj]
-        ln = np.linalg.norm(d, axis=1)
-        e = ln - net.l0
-        g = (net.k * e / ln)[:, None] * d
-        grad = np.zeros_like(x)
-        np.add.at(grad, net.si, g)
-        np.add.at(grad, net.sj, -g)
-        grad -= f
-        return 0.5 * float(net.k @ (e * e)) - float((f * x).sum()), grad[free].ravel()
-    res = minimize(energy, x0[free].ravel(), jac=True, method="L-BFGS-B",
-                   options={"maxiter": 20000, "gtol": 1e-8, "ftol": 1e-16, "maxcor": 30})
-    x = x0.copy()
-    x[free] = res.x.reshape(-1, 3)
-    return x, np.abs(res.jac).max()
+    return rest_under_load(net, f, free, gtol=1e-8, ftol=1e-16)
 
 
 def test_mat_under_load_rests_at_the_static_solution():

@@ -27,7 +27,8 @@ from interplay.systems.rigid import RigidBody  # noqa: E402
 from interplay.geometry.primitive import Primitive  # noqa: E402
 from interplay.kernels.rigid import quat_to_matrix  # noqa: E402
 from interplay.systems.colliders import box_surface  # noqa: E402
-from contact_checks import equal_and_opposite_every_step  # noqa: E402
+from contact_checks import contact_step, equal_and_opposite_every_step  # noqa: E402
+from static_reference import rest_under_load  # noqa: E402
 
 G = 9.81
 H = 1e-3  # s, the coupling step
@@ -35,12 +36,7 @@ H = 1e-3  # s, the coupling step
 
 def step(fig, bed, contact):
     """One coupling step as the scheduler takes it (the contact sub-cycled in the bed)."""
-    fig.clear_forces()
-    bed.clear_forces()
-    res = contact.exchange(True, True)
-    bed.advance(H, bed.dt)
-    if res is None:
-        res = contact.complete(True)
+    res = contact_step(fig, bed, contact, H)
     fig.advance(H)
     return res
 
@@ -86,7 +82,6 @@ def test_deepest_approach_matches_dense_sampling(kind):
 def _static_solve(net, load, half=0.15):
     """A slow reference: the bed's rest under the load as the minimum of its potential
     energy (springs, gravity, the load) by L-BFGS, from the flat bed."""
-    from scipy.optimize import minimize
     free = np.flatnonzero(~net.fixed)
     x0 = net.x.copy()
     bedpts = x0[:net.bed_points]
@@ -94,26 +89,7 @@ def _static_solve(net, load, half=0.15):
     f = np.zeros_like(x0)
     f[sel, 2] = -load / len(sel)
     f[:, 2] -= net.m * G
-
-    def energy(u):
-        x = x0.copy()
-        x[free] = u.reshape(-1, 3)
-        d = x[net.si] - x[net.sj]
-        ln = np.linalg.norm(d, axis=1)
-        e = ln - net.l0
-        slack = net.tension_only & (e < 0)
-        e[slack] = 0.0
-        grad = np.zeros_like(x)
-        g = (net.k * e / ln)[:, None] * d
-        np.add.at(grad, net.si, g)
-        np.add.at(grad, net.sj, -g)
-        grad -= f
-        return 0.5 * float(net.k @ (e * e)) - float((f * x).sum()), grad[free].ravel()
-    res = minimize(energy, x0[free].ravel(), jac=True, method="L-BFGS-B",
-                   options={"maxiter": 20000, "gtol": 1e-7, "ftol": 1e-15, "maxcor": 30})
-    x = x0.copy()
-    x[free] = res.x.reshape(-1, 3)
-    return x, np.abs(res.jac).max()
+    return rest_under_load(net, f, free, gtol=1e-7, ftol=1e-15)
 
 
 def test_bed_under_load_rests_at_the_static_solution_and_the_frame_carries_it():
