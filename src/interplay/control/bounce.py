@@ -92,11 +92,6 @@ class BounceParams:
     k_turn: float = param(0.003324037518460548, "m s/(kg m^2)", ge=-1.0, le=1.0)
     k_hip_spin: float = param(-0.06, "rad s/(kg m^2)", ge=-1.0, le=1.0)
     k_arms: float = param(0.05108273094290473, "-", ge=0.0, le=5.0)
-    k_trunk: float = param(0.0, "-", ge=0.0, le=10.0, doc="hips: pelvis upright in the world")
-    k_right: float = param(0.0, "kg m^2/(s rad)", ge=-50.0, le=50.0,
-                           doc="takeoff spin wanted per rad of backward lean")
-    lean_free: float = param(0.0, "rad", ge=-1.0, le=1.0,
-                             doc="takeoff lean the flight rights by itself")
 
     def validated(self) -> "BounceParams":
         for f in fields(self):
@@ -118,8 +113,7 @@ BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4),
           "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6), "k_place": (0.0, 1.0),
           "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5), "k_spin": (0.0, 0.05),
           "k_attitude": (0.0, 1.2), "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
-          "k_arms": (0.0, 1.5), "k_trunk": (0.0, 3.0),
-          "k_right": (0.0, 20.0), "lean_free": (-0.3, 0.1)}
+          "k_arms": (0.0, 1.5)}
 
 
 def controller(p: BounceParams) -> Controller:
@@ -199,27 +193,22 @@ class BounceBalance:
             # on the bed: the ankle strategy, steering the pressure under the feet to keep the
             # centre of mass over them and the body from rotating
             lead = (com - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ fwd
-            pitch, roll = pelvis_tilt(d.xmat[fig.root], fwd, left)
-            # the spin is servoed to the one that turns a leaning pelvis back upright in the
-            # coming flight (k_right per rad of lean beyond lean_free, what the flight's change
-            # of shape rights by itself), not to zero: a lean at takeoff is undone in the air
-            spin = (d.subtree_angmom[fig.root] @ left
-                    + p.k_right * (pitch - p.lean_free))  # > 0: more forward than wanted
+            spin = d.subtree_angmom[fig.root] @ left  # > 0: pitching forward
             want[self.ankles] = -(p.k_lead * lead + p.k_drift * (v @ fwd) + p.k_spin * spin)
             # and the hips: flexed by the legs' lean, the pelvis is held upright over them
             leg = (d.geom_xpos[fig.sole_geoms].mean(axis=0)
                    - d.xpos[fig.seg_body[self.thighs]].mean(axis=0))
-            # Raibert's attitude servo: the hips turn the pelvis back to upright in the world
-            # (flexing when it leans back), whatever the planted legs do in the bed's funnel
             want[self.flex] = (p.k_attitude * math.atan2(leg @ fwd, -leg[2])
-                               + p.k_hip_spin * spin - p.k_trunk * pitch)
+                               + p.k_hip_spin * spin)
             side = (p.k_attitude * math.atan2(leg @ left, -leg[2])
-                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd) - p.k_trunk * roll)
+                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd))
             want[self.abd_l], want[self.abd_r] = side, -side
         else:
             # in the air: place the feet ahead of the centre of mass to brake and steer back,
             # the hips turned against the pelvis's pitch and roll so the legs aim in the world
-            pitch, roll = pelvis_tilt(d.xmat[fig.root], fwd, left)
+            up = d.xmat[fig.root].reshape(3, 3)[:, 2]
+            pitch = math.atan2(up @ fwd, up[2])  # pelvis leaning forward: > 0
+            roll = math.atan2(-(up @ left), up[2])  # leaning to her right: > 0
             c = com[:2] - self.centre
             spin = d.subtree_angmom[fig.root]  # kg m^2/s: forward pitch about +left
             turn_fwd = p.k_turn * (spin @ left)  # spinning forward: land with the feet ahead
@@ -251,13 +240,6 @@ class BounceBalance:
             self.out[self.shoulders] = np.clip(self.out[self.shoulders]
                                                + rate * fig.control_dt, *ARM_RANGE)
         return self.out
-
-
-def pelvis_tilt(xmat, fwd, left) -> tuple[float, float]:
-    """(pitch, roll) (rad) of the pelvis's up axis from vertical: leaning forward > 0, leaning
-    to her right > 0; xmat its rotation (row-major 9), fwd and left the heading axes."""
-    up = np.asarray(xmat).reshape(3, 3)[:, 2]
-    return math.atan2(up @ fwd, up[2]), math.atan2(-(up @ left), up[2])
 
 
 def arm_inertia(fig) -> float:
