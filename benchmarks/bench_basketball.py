@@ -9,9 +9,9 @@ What is timed, and how:
    time ``result.primary_cycle_s``, and ``result.timings()`` of the last repeat.
 2. Two-way integrator variants: the default (explicit net at NetParams().dt, ball contact
    sub-cycled inside the net's kernel, coupling_dt 1e-3 s: the two-way entry of 1 is reused),
-   the same at dt 5e-5 s, the strict lock-step explicit reference (dt = coupling_dt = 1e-5 s)
-   and implicit (dt 1e-4 s). Beside each time: the ball's position at t = 0.6 s and its
-   distance from the reference's.
+   the same at dt 5e-5 s, the strict lock-step explicit reference (dt = coupling_dt = 1e-5 s),
+   implicit (dt 1e-4 s) and implicit at dt = coupling_dt = 1e-3 s. Beside each time: the
+   ball's position at t = 0.6 s and its distance from the reference's.
 3. MuJoCo (if installed), built in code with MjSpec: a free shell sphere; one body per knot
    (3 slide joints; the top row pinned: no joints) with our lumped masses and mass damping; a
    1-D flex on the knots for ball-net contact (friction 1.0); one spatial tendon per cord,
@@ -21,6 +21,12 @@ What is timed, and how:
    bad-acceleration reset, finite, ball below 1 m at t = 1 s, knots within 1 m of the rim
    circle); the largest stable step is timed (mj_step calls only, after an untimed run).
    Compilation is timed separately. integrator = implicitfast.
+   A second construction (``mujoco_flex``), MuJoCo's fastest faithful one by issue 22: no
+   tendons, the flex's edges held at rest length by a flex equality constraint (solref two
+   steps), swept over MJ_FLEX_STEPS, with each step's largest cord strain; the largest step
+   whose cords stretched at most 5% is timed.
+   For every run of ours and MuJoCo's, the ball at each checkpoint and its distance from the
+   reference's (``ball_path_m``, ``ball_path_error_m``).
 4. Ratios from the same run (medians). 5. Machine, versions, thread env vars, load average,
    commit. Wall-clock on a shared machine: orders of magnitude, not a test.
 Run: ``.venv/bin/python benchmarks/bench_basketball.py --out out/bench [--repeats N] [--quick]``.
@@ -59,6 +65,8 @@ DURATION = 1.5  # s, the scene's default length
 T_CHECK = 0.6  # s, where the ball's position is compared (B.FIT_TIME)
 MODES = ("two-way", "one-way", "hybrid")
 MJ_STEPS = (2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5)  # s, MuJoCo timesteps tried, largest first
+# the flex net's steps: 1.56e-3 s is the one issue 22 found holding its cords under 5% strain
+MJ_FLEX_STEPS = (3e-3, 2e-3, 1.56e-3, 1e-3, 5e-4, 2e-4)
 REF = "explicit_dt1e-5_lockstep"
 
 
@@ -69,6 +77,18 @@ def spread(samples) -> dict:
 
 def ball_at(result, t=T_CHECK) -> list:
     return np.asarray(result.state_at("ball", t)[0][:3], float).tolist()
+
+
+def ball_path(result) -> dict:
+    """The ball's position (m) at each of the scene's checkpoints, keyed by the time (s)."""
+    return {str(t): ball_at(result, t) for t in B.CHECKPOINTS}
+
+
+def path_errors(path, ref) -> dict | None:
+    """Distance (m) of a ball path from the reference's at each checkpoint both have."""
+    if not path or not ref:
+        return None
+    return {t: float(np.linalg.norm(np.subtract(path[t], ref[t]))) for t in ref if t in path}
 
 
 def time_scene(make, repeats):
@@ -91,6 +111,7 @@ def bench_modes(repeats) -> dict:
         out[mode] = {"wall_s": spread(walls), "total_s": spread(r.total_s for r in rs),
                      "primary_cycle_s": spread(r.primary_cycle_s for r in rs),
                      "timings": rs[-1].timings(), "ball_at_0.6_m": ball_at(rs[-1]),
+                     "ball_path_m": ball_path(rs[-1]),
                      "warnings": [str(w) for w in rs[-1].warnings]}
     return out
 
@@ -102,7 +123,7 @@ def bench_variants(repeats, modes) -> dict:
         "description": f"default: explicit net dt {p.net.dt:g} s, contact sub-cycled, "
                        f"coupling_dt {p.coupling_dt:g} s (the runs of modes.two-way)",
         "net_dt_s": p.net.dt, "coupling_dt_s": p.coupling_dt, "wall_s": tw["wall_s"],
-        "ball_at_0.6_m": tw["ball_at_0.6_m"]}}
+        "ball_at_0.6_m": tw["ball_at_0.6_m"], "ball_path_m": tw["ball_path_m"]}}
     runs = {"explicit_dt5e-5_subcycled": ("explicit net dt 5e-5 s, contact sub-cycled, "
                                           "coupling_dt 1e-3 s", 5e-5, p.coupling_dt,
                                           lambda: B.build("two-way", dt=5e-5)),
@@ -111,7 +132,12 @@ def bench_variants(repeats, modes) -> dict:
                                   params=dataclasses.replace(B.BasketballParams(), coupling_dt=1e-5))),
             "implicit_dt1e-4": ("implicit net dt 1e-4 s, coupling_dt 1e-3 s", 1e-4,
                                 p.coupling_dt,
-                                lambda: B.build("two-way", integrator="implicit", dt=1e-4))}
+                                lambda: B.build("two-way", integrator="implicit", dt=1e-4)),
+            # the ball solved with the knots (docs/coupling.md), at the coupling step
+            "implicit_dt1e-3": ("implicit net dt = coupling_dt = 1e-3 s", 1e-3, 1e-3,
+                                lambda: B.build("two-way", integrator="implicit", dt=1e-3,
+                                                params=dataclasses.replace(
+                                                    B.BasketballParams(), coupling_dt=1e-3)))}
     for name, (desc, dt, hc, make) in runs.items():
         entry = {"description": desc, "net_dt_s": dt, "coupling_dt_s": hc}
         try:
@@ -120,19 +146,24 @@ def bench_variants(repeats, modes) -> dict:
             entry["error"] = str(e)
         else:
             entry.update(wall_s=spread(walls), timings=rs[-1].timings(),
-                         **{"ball_at_0.6_m": ball_at(rs[-1])})
+                         ball_path_m=ball_path(rs[-1]), **{"ball_at_0.6_m": ball_at(rs[-1])})
         out[name] = entry
     ref = out[REF].get("ball_at_0.6_m")
     for entry in out.values():
         if ref is not None and "ball_at_0.6_m" in entry:
             entry["ball_error_vs_reference_m"] = float(np.linalg.norm(
                 np.subtract(entry["ball_at_0.6_m"], ref)))
+        entry["ball_path_error_m"] = path_errors(entry.get("ball_path_m"),
+                                                 out[REF].get("ball_path_m"))
     return out
 
 
 # --- MuJoCo ----------------------------------------------------------------------------------
-def mj_model(mujoco, timestep: float):
-    """The scene as an MjModel (see the module docstring); returns (model, compile seconds)."""
+def mj_model(mujoco, timestep: float, cords: str = "tendons"):
+    """The scene as an MjModel (see the module docstring); returns (model, compile seconds).
+    cords: "tendons" (tension-only spatial tendons, k = EA/l0) or "flex-equality" (the flex's
+    edges held at their rest lengths by MuJoCo's flex equality constraint, its default soft
+    solref: inextensible cords that also resist compression)."""
     p = B.BasketballParams()
     netp, ballp = p.net, p.ball
     x, pairs = net_knots(netp)
@@ -172,7 +203,11 @@ def mj_model(mujoco, timestep: float):
     f.elem = pairs.ravel().tolist()
     f.friction = [p.contact.friction, 0.005, 1e-4]
     f.selfcollide = mujoco.mjtFlexSelf.mjFLEXSELF_NONE
-    for c, (a, b) in enumerate(pairs):  # the cords' elasticity
+    if cords == "flex-equality":
+        # as stiff as MuJoCo's soft constraints go stably: a time constant of two steps
+        spec.add_equality(type=mujoco.mjtEq.mjEQ_FLEX, name1="net",
+                          objtype=mujoco.mjtObj.mjOBJ_FLEX, solref=[2.0 * timestep, 1.0])
+    for c, (a, b) in enumerate(pairs if cords == "tendons" else ()):  # the cords' elasticity
         t = spec.add_tendon(name=f"cord{c}", stiffness=float(k[c]),
                             damping=float(netp.stiffness_damping * k[c]),
                             springlength=[0.0, float(l0[c])])  # dead band: tension only
@@ -219,11 +254,21 @@ def mj_check(mujoco, model, qpos) -> dict:
     ts = model.opt.timestep
     d = mj_start(mujoco, model, qpos)
     knots = model.body("knot0").id
+    x, pairs = net_knots(netp)
+    l0 = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
     chunk = max(1, int(round(1e-3 / ts)))
     n = int(round(DURATION / ts))
-    out = {"ball_at_0.6_m": None, "ball_z_at_1s_m": None, "max_knot_rim_distance_m": 0.0}
-    for i in range(chunk, n + 1, chunk):
-        mujoco.mj_step(model, d, nstep=chunk)
+    marks = {int(round(t / ts)): str(t) for t in B.CHECKPOINTS}
+    out = {"ball_at_0.6_m": None, "ball_z_at_1s_m": None, "max_knot_rim_distance_m": 0.0,
+           "max_cord_strain": 0.0, "ball_path_m": {}}
+    i = 0
+    while i < n:
+        # to the next checkpoint or 1 ms on, whichever comes first
+        step = min([chunk] + [k - i for k in marks if k > i])
+        mujoco.mj_step(model, d, nstep=step)
+        i += step
+        if i in marks:
+            out["ball_path_m"][marks[i]] = np.asarray(d.qpos[:3], float).tolist()
         if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.isfinite(d.qpos).all():
             out["failure"] = f"bad acceleration (MuJoCo reset the state) at t = {i * ts:.4f} s"
             break
@@ -231,10 +276,11 @@ def mj_check(mujoco, model, qpos) -> dict:
         dist = np.hypot(np.hypot(xk[:, 0], xk[:, 1]) - netp.rim_radius,
                         xk[:, 2] - netp.rim_height).max()
         out["max_knot_rim_distance_m"] = max(out["max_knot_rim_distance_m"], float(dist))
-        if i == int(round(T_CHECK / ts)):
-            out["ball_at_0.6_m"] = np.asarray(d.qpos[:3], float).tolist()
-        if i == int(round(1.0 / ts)):
+        strain = np.linalg.norm(xk[pairs[:, 0]] - xk[pairs[:, 1]], axis=1) / l0 - 1.0
+        out["max_cord_strain"] = max(out["max_cord_strain"], float(strain.max()))
+        if out["ball_z_at_1s_m"] is None and i * ts >= 1.0 - 0.5 * ts:
             out["ball_z_at_1s_m"] = float(d.qpos[2])
+    out["ball_at_0.6_m"] = out["ball_path_m"].get(str(T_CHECK))
     if "failure" not in out:
         if out["max_knot_rim_distance_m"] > 1.0:
             out["failure"] = "a knot left the 1 m ball around the rim"
@@ -256,7 +302,12 @@ def mj_timed(mujoco, model, qpos):
     return time.perf_counter() - t0, b06
 
 
-def bench_mujoco(repeats, ref) -> dict:
+def bench_mujoco(repeats, ref, ref_path, cords="tendons", steps=MJ_STEPS,
+                 strain_limit=None) -> dict:
+    """One MuJoCo construction of the scene (mj_model's ``cords``): a checked run at each of
+    ``steps``, then the largest stable one (whose cords stretched at most ``strain_limit``,
+    if given: a faithful net) timed; the ball against our reference (at 0.6 s, ``ref``, and
+    at every checkpoint, ``ref_path``)."""
     try:
         import mujoco
     except ImportError:
@@ -266,28 +317,37 @@ def bench_mujoco(repeats, ref) -> dict:
     err = (lambda b: None if b is None or ref is None
            else float(np.linalg.norm(np.subtract(b, ref))))
     sweep = []
-    for ts in MJ_STEPS:
-        model, _ = mj_model(mujoco, ts)
+    for ts in steps:
+        model, _ = mj_model(mujoco, ts, cords)
         qpos, _, ok = mj_settle(mujoco, model)
         row = ({"timestep_s": ts, "stable": False, "failure": "net blew up while settling"}
                if not ok else {"timestep_s": ts, **mj_check(mujoco, model, qpos)})
         row["ball_error_vs_reference_m"] = err(row.get("ball_at_0.6_m"))
+        row["ball_path_error_m"] = path_errors(row.get("ball_path_m"), ref_path)
         sweep.append(row)
     stable = [r["timestep_s"] for r in sweep if r["stable"]]
+    timed = [r["timestep_s"] for r in sweep if r["stable"] and (
+        strain_limit is None or r["max_cord_strain"] <= strain_limit)]
     out = {"version": mujoco.__version__, "integrator": "implicitfast",
-           "cords": "spatial tendons (tension-only, k = EA/l0) + a 1-D flex for contact",
-           "sweep": sweep, "stable_timesteps_s": stable}
-    if stable:
-        ts = stable[0]
-        model, compile_s = mj_model(mujoco, ts)
+           "cords": {"tendons": "spatial tendons (tension-only, k = EA/l0) + a 1-D flex for "
+                                "contact",
+                     "flex-equality": "a 1-D flex whose edges a flex equality constraint "
+                                      "holds at rest length (solref 2 steps)"}[cords],
+           "sweep": sweep, "stable_timesteps_s": stable, "strain_limit": strain_limit}
+    if timed:
+        ts = timed[0]
+        model, compile_s = mj_model(mujoco, ts, cords)
         qpos, settle_s, _ = mj_settle(mujoco, model)
         mj_timed(mujoco, model, qpos)  # untimed: warm caches
         runs = [mj_timed(mujoco, model, qpos) for _ in range(repeats)]
         walls = [w for w, _ in runs]
         n = int(round(DURATION / ts))
+        row = sweep[steps.index(ts)]
         out.update(timestep_s=ts, compile_s=compile_s, settle_s=settle_s, wall_s=spread(walls),
                    steps=n, us_per_step=1e6 * statistics.median(walls) / n, nv=int(model.nv),
                    ntendon=int(model.ntendon), nflexedge=int(model.nflexedge),
+                   max_cord_strain=row["max_cord_strain"],
+                   ball_path_error_m=row["ball_path_error_m"],
                    **{"ball_at_0.6_m": runs[-1][1],
                       "ball_error_vs_reference_m": err(runs[-1][1])})
     out["warnings_logged"] = len(log)
@@ -332,7 +392,7 @@ def source() -> dict:
             "src_uncommitted": [ln[3:] for ln in st.stdout.splitlines()]}
 
 
-def ratios(modes, variants, mj) -> dict:
+def ratios(modes, variants, mj, mj_flex) -> dict:
     med = lambda e: e["wall_s"]["median"] if e and "wall_s" in e else None  # noqa: E731
     tw = modes["two-way"]["total_s"]["median"]  # result.total_s: the coupled run's wall time
     out = {"two_way_real_time_factor": med(modes["two-way"]) / DURATION,
@@ -340,11 +400,13 @@ def ratios(modes, variants, mj) -> dict:
                modes["hybrid"]["primary_cycle_s"]["median"] / tw,
            "one_way_primary_over_two_way_total":
                modes["one-way"]["primary_cycle_s"]["median"] / tw}
-    for name in (REF, "implicit_dt1e-4"):
+    for name in (REF, "implicit_dt1e-4", "implicit_dt1e-3"):
         if med(variants[name]) is not None:
             out[f"{name}_over_default"] = med(variants[name]) / med(modes["two-way"])
     if med(mj) is not None:
         out["mujoco_over_two_way"] = med(mj) / med(modes["two-way"])
+    if med(mj_flex) is not None:
+        out["mujoco_flex_over_two_way"] = med(mj_flex) / med(modes["two-way"])
     return out
 
 
@@ -357,8 +419,9 @@ def print_table(data, path):
         t.add_column(c)
     rows = [(f"ours {k}", e) for k, e in data["modes"].items()]
     rows += [(f"two-way {k}", e) for k, e in data["variants"].items()]
-    if "wall_s" in data["mujoco"]:
-        rows.append((f"MuJoCo dt {data['mujoco']['timestep_s']:g}", data["mujoco"]))
+    for key, label in (("mujoco", "MuJoCo tendons"), ("mujoco_flex", "MuJoCo flex eq.")):
+        if "wall_s" in data[key]:
+            rows.append((f"{label} dt {data[key]['timestep_s']:g}", data[key]))
     for name, e in rows:
         w, ball = e.get("wall_s", {}), e.get("ball_at_0.6_m")
         t.add_row(name, fmt(w.get("median")), fmt(w.get("min")),
@@ -370,6 +433,13 @@ def print_table(data, path):
     mj = data["mujoco"]
     con.print(f"MuJoCo: {mj['skipped']}" if "skipped" in mj else
               f"MuJoCo stable timesteps (s): {mj['stable_timesteps_s']} of {list(MJ_STEPS)}")
+    fl = data["mujoco_flex"]
+    for row in fl.get("sweep", ()):
+        errs = row.get("ball_path_error_m") or {}
+        con.print(f"MuJoCo flex equality dt {row['timestep_s']:g}: "
+                  + ("stable" if row["stable"] else row.get("failure", "unstable"))
+                  + f", cord strain up to {row.get('max_cord_strain', float('nan')):.1%}, "
+                  + "ball off by " + ", ".join(f"{e:.3f}" for e in errs.values()) + " m")
     con.print("ratios: " + ", ".join(f"{k} {v:.3g}" for k, v in data["ratios"].items()))
     con.print(f"wrote {path}")
 
@@ -385,11 +455,14 @@ def main(argv=None) -> Path:
     info = machine()
     modes = bench_modes(repeats)
     variants = bench_variants(repeats, modes)
-    mj = bench_mujoco(repeats, variants[REF].get("ball_at_0.6_m"))
+    ref, ref_path = variants[REF].get("ball_at_0.6_m"), variants[REF].get("ball_path_m")
+    mj = bench_mujoco(repeats, ref, ref_path)
+    mj_flex = bench_mujoco(repeats, ref, ref_path, "flex-equality", MJ_FLEX_STEPS,
+                           strain_limit=0.05)
     info["loadavg_end"] = list(os.getloadavg())
     data = {"benchmark": "basketball", "duration_s": DURATION, "repeats": repeats,
             "machine": info, "modes": modes, "variants": variants, "mujoco": mj,
-            "ratios": ratios(modes, variants, mj)}
+            "mujoco_flex": mj_flex, "ratios": ratios(modes, variants, mj, mj_flex)}
     path = Path(a.out) / "bench_basketball.json"
     with atomic_path(path) as tmp:  # temp file beside it, then os.replace
         tmp.write_text(json.dumps(data, indent=2) + "\n")

@@ -204,7 +204,7 @@ def test_vest_row_against_table_one(vested):
     assert res.advice_for(res.interaction("vest"))["mode"] == "one-way"
 
 
-@pytest.mark.xfail(strict=True, reason="issue 20's bar, not met: the vest's peak is ~4.6x the "
+@pytest.mark.xfail(strict=True, reason="issue 20's bar, not met: the vest's peak is ~3.3x the "
                    "paper's 31.9 N; at the jerk his torso decelerates at ~150-200 m/s^2 and the "
                    "vest on it with him (docs/owl-creek.md)")
 @pytest.mark.slow

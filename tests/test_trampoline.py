@@ -44,24 +44,27 @@ def step(fig, bed, contact):
 # --- geometry -----------------------------------------------------------------------------
 def _signed_distance(kind, p, q, size, pts):
     """Brute-force signed distance (m) of points (n,3) from a primitive at rest (identity)."""
-    if kind == PC.BOX:
-        d = np.abs(pts - p) - size
+    if kind == PC.BOX:  # q[0]: the rounding, the inner box grown by it
+        d = np.abs(pts - p) - (size - q[0])
         out = np.linalg.norm(np.maximum(d, 0.0), axis=1)
-        return np.where(d.max(axis=1) > 0, out, d.max(axis=1))
+        return np.where(d.max(axis=1) > 0, out, d.max(axis=1)) - q[0]
     b = q if kind == PC.CAPSULE else p
     ab = b - p
     t = np.clip(((pts - p) @ ab) / max(ab @ ab, 1e-30), 0.0, 1.0)
     return np.linalg.norm(pts - (p + t[:, None] * ab), axis=1) - size[0]
 
 
-@pytest.mark.parametrize("kind", [PC.SPHERE, PC.CAPSULE, PC.BOX])
-def test_deepest_approach_matches_dense_sampling(kind):
-    """The kernel's deepest point of a segment against a sphere, capsule or box agrees with
-    the minimum over 4001 samples along it. Tolerance: the samples' spacing L/4000 plus the
-    golden-section bracket L 0.618^14 (the signed distance is 1-Lipschitz along the
-    segment)."""
+@pytest.mark.parametrize("kind, rounding", [(PC.SPHERE, 0.0), (PC.CAPSULE, 0.0),
+                                            (PC.BOX, 0.0), (PC.BOX, 0.02)])
+def test_deepest_approach_matches_dense_sampling(kind, rounding):
+    """The kernel's deepest point of a segment against a sphere, capsule, box or rounded box
+    agrees with the minimum over 4001 samples along it. Tolerance: the samples' spacing
+    L/4000 plus the golden-section bracket L 0.618^14 (the signed distance is 1-Lipschitz
+    along the segment)."""
     rng = np.random.default_rng(kind)
     p, q = np.array([0.01, -0.02, 0.0]), np.array([0.05, 0.03, -0.2])
+    if kind == PC.BOX:  # q is a box's rounding in q[0]
+        q = np.array([rounding, 0.0, 0.0])
     size = np.array([0.05, 0.0, 0.0]) if kind != PC.BOX else np.array([0.12, 0.05, 0.03])
     scratch = [np.empty(3) for _ in range(5)]
     s = np.linspace(0.0, 1.0, 4001)

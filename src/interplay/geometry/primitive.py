@@ -10,7 +10,8 @@ import numpy as np
 @dataclass(frozen=True)
 class Primitive:
     """kind "sphere" (radius, centre), "ellipsoid" (semi-axes along the part's axes, centre),
-    "capsule" (radius, segment ends a and b) or "box" (half extents ``axes``, centre); m."""
+    "capsule" (radius, segment ends a and b) or "box" (half extents ``axes``, centre; a
+    radius > 0: its edges rounded by it within them, as the part contact sees it); m."""
     kind: str
     radius: float = 0.0
     axes: tuple = (0.0, 0.0, 0.0)

@@ -26,9 +26,9 @@ from ..params import param
 
 @dataclass(frozen=True)
 class VestParams:
-    """enabled: dress him in it (off by default: at the jerk the straps, draped over the
-    torso box's sharp top edges, tear at any step above ~1e-4 s, and at 1e-4 s the vest
-    costs several times the rest of the scene: docs/owl-creek.md); coupling: the vest's (one-way: its pull on him is measured,
+    """enabled: dress him in it (off by default: above ~1e-4 s the vest sinks into him by
+    more than its skin at the jerk, and at 1e-4 s it costs several times the rest of the
+    scene: docs/owl-creek.md); coupling: the vest's (one-way: its pull on him is measured,
     not applied); mass (kg, the paper's 0.5 kg: a heavy lined vest); ease (m): its clearance
     outside the torso; hem (m): its lower edge above the torso's bottom (the waist: the bound
     forearms cross behind the back below it); neck (m): half the neckline's width, the

@@ -40,7 +40,9 @@ class PartContactParams:
     chooses them per contact from the effective mass and the substep; contact_steps: the
     substeps over which a penetration is resolved (with the default stiffness); constraint:
     include the constraint term; margin (m): how much farther than a part can reach in a step
-    its candidate elements are gathered."""
+    its candidate elements are gathered; rounding (m): the parts' boxes seen with their edges
+    and corners rounded by this radius (within the box; a box primitive's own radius wins),
+    as a torso is: cloth draped over a sharp edge is folded over it, and thrown off it."""
     thickness: float = param(0.004, "m", ge=0.0, le=0.2)
     friction: float = param(0.8, "-", ge=0.0, le=10.0)
     eps: float = param(0.01, "m/s", gt=0.0, le=10.0)
@@ -49,6 +51,7 @@ class PartContactParams:
     contact_steps: float = param(3.0, "substeps", ge=1.0, le=1000.0)
     constraint: bool = param(True, doc="include the constraint term")
     margin: float = param(0.01, "m", ge=0.0, le=1.0)
+    rounding: float = param(0.0, "m", ge=0.0, le=0.2, doc="boxes' edges rounded by this radius")
 
     def validated(self, owner: str) -> "PartContactParams":
         require_nonnegative(owner, "contact thickness", self.thickness, "m")
@@ -60,6 +63,7 @@ class PartContactParams:
             require_nonnegative(owner, "contact damping", self.damping, "N s/m")
         require_positive(owner, "contact_steps", self.contact_steps)
         require_nonnegative(owner, "candidate margin", self.margin, "m")
+        require_nonnegative(owner, "box rounding", self.rounding, "m")
         return self
 
     def law(self) -> np.ndarray:
@@ -144,6 +148,7 @@ class PartContact(Interaction):
                 reach[j] = max(np.linalg.norm(p[j]), np.linalg.norm(q[j])) + pr.radius
             elif pr.kind == "box":
                 p[j], size[j] = np.asarray(pr.centre) - off, pr.axes
+                q[j, 0] = min(pr.radius or self.p.rounding, min(pr.axes))  # its rounding
                 reach[j] = np.linalg.norm(p[j]) + np.linalg.norm(size[j])
             else:
                 p[j], size[j, 0] = np.asarray(pr.centre) - off, pr.radius

@@ -33,8 +33,10 @@ class Parts(NamedTuple):
 
     Primitive in each part's frame, relative to its centre of mass: kind (k,) SPHERE, CAPSULE
     or BOX; p (k,3) a sphere's or box's centre or a capsule's first end (m); q (k,3) a
-    capsule's second end (m); size (k,3) the radius in [0] (sphere, capsule) or a box's half
-    extents (m); reach (k,) m the primitive's farthest point from the centre of mass.
+    capsule's second end (m), or in q[0] a box's rounding: its edges and corners rounded by
+    that radius (m; 0: sharp); size (k,3) the radius in [0] (sphere, capsule) or a box's half
+    extents (m, the rounding within them); reach (k,) m the primitive's farthest point from
+    the centre of mass.
     Motion at the step's start: centres (k,3) m, rotations (k,3,3) part to world, velocities
     (k,3) m/s, spins (k,3) rad/s, accels (k,3) m/s^2; masses (k,) kg; law (k,6) each part's
     contact law (kernels/contact.py; STIFFNESS, DAMPING < 0: from the pair's mass, resolving
@@ -225,7 +227,12 @@ def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
         e0 = R[0, 0] * bx + R[1, 0] * by + R[2, 0] * bz - a0
         e1 = R[0, 1] * bx + R[1, 1] * by + R[2, 1] * bz - a1
         e2 = R[0, 2] * bx + R[1, 2] * by + R[2, 2] * bz - a2
-        h0, h1, h2 = size[0], size[1], size[2]
+        # a rounded box is the inner box (half extents less the rounding) grown by the
+        # rounding: its signed distance the inner box's less the rounding, the same normal
+        rnd = q[0]
+        h0, h1, h2 = size[0] - rnd, size[1] - rnd, size[2] - rnd
+        inner = np.empty(3)
+        inner[0], inner[1], inner[2] = h0, h1, h2
         t = 0.0
         if ia != ib:
             lo, hi = 0.0, 1.0
@@ -253,7 +260,7 @@ def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
                 t = 1.0
         for r in range(3):
             X[r] = xa[r] + t * (xb[r] - xa[r])
-        s = _box_sd(A, R, size, X[0], X[1], X[2], n)
+        s = _box_sd(A, R, inner, X[0], X[1], X[2], n) - rnd
         for r in range(3):
             P[r] = X[r] - s * n[r]  # the box's surface point nearest X
             n[r] = -n[r]  # outward from the box points at the element: flip to element -> part

@@ -11,7 +11,7 @@ from ..geometry import shapes
 from ..geometry.anthropometry import SEGMENTS
 from ..geometry.garment import FABRICS, Garment
 from ..geometry.setpieces import merge, rod
-from ..geometry.vest import VestParams, vest_mesh
+from ..geometry.vest import CORNER, VestParams, vest_mesh
 from ..interactions.aero import AeroParams, Aerodynamics
 from ..interactions.part_contact import PartContact, PartContactParams
 from ..outputs.geometry import quat_rotate
@@ -40,7 +40,10 @@ class DrapeParams:
 
 
 #: the vest against his torso: a thin skin (the fabric's ~2 mm), wool on cloth friction
-VEST_CONTACT = PartContactParams(thickness=0.002, friction=0.5, contact_steps=3.0)
+# the torso and pelvis boxes rounded as the vest's rings are cut round them (CORNER): a
+# strap over a sharp shoulder edge was folded over it and thrown off it at the rope's jerk
+VEST_CONTACT = PartContactParams(thickness=0.002, friction=0.5, contact_steps=3.0,
+                                 rounding=CORNER)
 
 
 def vest(scene, fig, p: VestParams, opens: float):
