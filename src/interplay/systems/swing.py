@@ -27,7 +27,7 @@ from .figure import Figure, FigureParams
 from .figure_model import FIGURE_GROUP, WORLD_GROUP, build_model
 from .shape import figure_shape
 
-GRIP_CLEARANCE = 0.10  # m: the least chain above her grip (a hand under the bar, not on it)
+HEAD_CLEARANCE = 0.10  # m: the least room between the top of her head and the bar
 
 
 @dataclass(frozen=True)
@@ -220,9 +220,11 @@ def _seated(params: FigureParams, p: SwingParams):
     seat_top = p.bar - p.chain
     shift = np.array([-grips[:, 0].mean(), 0.0, seat_top - (hip_z - thigh.shape[1])])
     grips, root = grips + shift, root + shift
-    if p.bar - grips[:, 2].max() < GRIP_CLEARANCE:
+    head = plan[SEGMENTS.index("head")]
+    crown = data.xpos[body["head"]][2] + head.shape[2][2] + head.shape[1] + shift[2]
+    if p.bar - crown < HEAD_CLEARANCE:
         raise ParameterError(f"swing: chain {p.chain} m is too short for a {params.body.height}"
-                             f" m child: her hands would be {grips[:, 2].max() - p.bar:+.2f} m "
-                             f"from the bar; use a chain of at least "
-                             f"{p.chain + grips[:, 2].max() - p.bar + GRIP_CLEARANCE:.2f} m")
+                             f" m child: seated, the top of her head would be "
+                             f"{crown - p.bar:+.2f} m from the bar; use a chain of at least "
+                             f"{p.chain + crown - p.bar + HEAD_CLEARANCE:.2f} m")
     return shift, grips, float(-root[0])
