@@ -131,7 +131,7 @@ def frame_mesh(s: SwingParams):
     return merge(*parts)
 
 
-def build(coupling: str = "one-way", duration: float = 30.0, fps: float = 30.0,
+def build(coupling: str = "one-way", duration: float = 12.0, fps: float = 30.0,
           integrator: str | None = None, dt: float | None = None,
           params: SwingSceneParams = SwingSceneParams()) -> Scene:
     """The scene; dt overrides MuJoCo's step (s)."""
@@ -202,9 +202,9 @@ def figures(result) -> dict:
 SPEC = SceneSpec(
     "swing", "a child on a playground swing pumps it higher (leans back, legs out, on the "
     "forward swing; sits up, legs tucked, on the backward one)", build, SwingSceneParams,
-    couplings=("one-way",), duration=30.0, fps=30.0,
+    couplings=("one-way",), duration=12.0, fps=30.0,
     # from the side, a little in front: the whole arc of the swing and the frame
-    camera=TrackingCamera("child", offset=(1.2, -4.6, -0.1), target_offset=(0.0, 0.0, 0.3),
+    camera=TrackingCamera("child", offset=(1.0, -3.3, -0.1), target_offset=(0.0, 0.0, 0.1),
                           axes=(0.0, 0.0, 0.0), hold=(0.0, 0.0, 1.2), fov_deg=45.0,
                           smooth_s=0.3),
-    key_time=20.0, figures=figures, heavy=True)
+    key_time=6.0, figures=figures, heavy=True)

@@ -73,7 +73,11 @@ class Figure(System, RigidParts):
 
     feedback: None, or an object with ``offsets(figure, sensors) -> (joints,)`` rad added to
     the targets at every control tick (a scene's own balance law: control/bounce.py) and
-    ``capture()`` / ``restore(snap)`` of its memory as plain arrays."""
+    ``capture()`` / ``restore(snap)`` of its memory as plain arrays.
+
+    extend: None, or ``extend(spec, bodies)`` adding a scene's own bodies to her MuJoCo model
+    (figure_model.build_model; the swing she sits on, systems/swing.py); her mass is her
+    segments' alone."""
 
     integrator = "MuJoCo implicitfast, PD servo actuators"
 
