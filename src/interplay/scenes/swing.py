@@ -205,6 +205,6 @@ SPEC = SceneSpec(
     couplings=("one-way",), duration=12.0, fps=30.0,
     # from the side, a little in front: the whole arc of the swing and the frame
     camera=TrackingCamera("child", offset=(1.0, -3.3, -0.1), target_offset=(0.0, 0.0, 0.1),
-                          axes=(0.0, 0.0, 0.0), hold=(0.0, 0.0, 1.2), fov_deg=45.0,
+                          axes=(0.0, 0.0, 0.0), hold=(0.0, 0.0, 1.35), fov_deg=45.0,
                           smooth_s=0.3),
     key_time=6.0, figures=figures, heavy=True)
