@@ -96,8 +96,8 @@ def test_pumping_raises_the_amplitude_and_sitting_still_lets_it_decay():
 def test_the_skirt_is_certified_every_frame_and_the_advisor_says_one_way():
     """2 s of the scene: one certificate per output frame, at its time (none from the cost
     estimate's frame before the pass, when she is not yet where the cloth is), with
-    cloth-body crossings, penetration, self-crossings and stretch; the skirt (~0.1 kg) pulls on her 25 kg at far below 10% of g,
-    so the advisor says one-way from its logged forces."""
+    cloth-body crossings, penetration, self-crossings and stretch; the skirt (0.08 kg) pulls
+    on her 25 kg at far below 10% of g, so the advisor says one-way from its logged forces."""
     res = S.build(duration=2.0, fps=30.0).simulate()
     cert = res.diagnostics["skirt"]["certificates"]
     assert [c["t"] for c in cert["per_frame"]] == pytest.approx(res.frames["skirt"]["t"],

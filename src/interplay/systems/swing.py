@@ -50,7 +50,8 @@ class SwingParams:
 
 
 #: her seated pose on the swing (rad): thighs along the seat, shanks hanging, upright; the
-#: hands hold the chains at her chest, just ahead of her shoulders, elbows bent
+#: hands hold the chains beside her hips, at the seat's height, elbows bent (a child grips
+#: higher, at her chest: docs/swing.md)
 SEATED = (("hip_flex", 1.57), ("knee", 1.57), ("ankle", 0.0), ("waist_flex", 0.0),
           ("shoulder_flex", -0.4), ("shoulder_abd", 0.18), ("elbow", 0.9))
 
@@ -94,12 +95,12 @@ class SwingFigure(Figure):
     def __init__(self, name: str, params: FigureParams, swing: SwingParams = SwingParams(),
                  controller=None, feedback=None):
         self.swing = swing
-        root, hands, seat_x = _seated(params, swing)
+        root, hands = _seated(params, swing)
         params = FigureParams(**{**params.__dict__, "position": tuple(root)})
 
         def extend(spec, bodies):
-            swing_body(spec, swing, grips=hands)
             import mujoco
+            swing_body(spec, swing, grips=hands)
             for k, hand in enumerate(("l_hand", "r_hand")):
                 bodies[hand].add_site(name=f"palm_{k}", pos=_palm(self.plan, hand))
                 spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_SITE,
@@ -112,7 +113,6 @@ class SwingFigure(Figure):
         self._sq, self._sv = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
         self.swing_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "swing")
         self.swing_mass = float(m.body_mass[self.swing_body])
-        self.seat_offset = seat_x
         self._pose(swing.start)
 
     def _pose(self, angle: float):
@@ -199,9 +199,9 @@ def _pose_vector(joints) -> np.ndarray:
 
 def _seated(params: FigureParams, p: SwingParams):
     """Where she sits on the swing hanging still: (her Figure position (m): where her pelvis's
-    rest position is carried to, grip points (2,3) m on her hands, her hips' distance behind
-    the chains (m)). Her thighs rest on the seat's top;
-    her root is placed so that her hands are on the chains' line (x = 0) and between them."""
+    rest position is carried to, grip points (2,3) m on her hands). Her thighs rest on the
+    seat's top and her hands are on the chains' line (x = 0); the grips are where her hands
+    are (the chains are drawn at +-width/2, her seated hands ~1 cm inside them)."""
     import mujoco
     from ..geometry.anthropometry import body_plan, joint_names
     plan = body_plan(params.body)
@@ -214,12 +214,11 @@ def _seated(params: FigureParams, p: SwingParams):
     body = {s: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, s) for s in SEGMENTS}
     grips = np.array([data.xpos[body[h]] + data.xmat[body[h]].reshape(3, 3) @ _palm(plan, h)
                       for h in ("l_hand", "r_hand")])
-    root = data.xpos[body["pelvis"]].copy()
     thigh = plan[SEGMENTS.index("l_thigh")]
     hip_z = data.xpos[body["l_thigh"]][2]
     seat_top = p.bar - p.chain
     shift = np.array([-grips[:, 0].mean(), 0.0, seat_top - (hip_z - thigh.shape[1])])
-    grips, root = grips + shift, root + shift
+    grips = grips + shift
     head = plan[SEGMENTS.index("head")]
     crown = data.xpos[body["head"]][2] + head.shape[2][2] + head.shape[1] + shift[2]
     if p.bar - crown < HEAD_CLEARANCE:
@@ -227,4 +226,4 @@ def _seated(params: FigureParams, p: SwingParams):
                              f" m child: seated, the top of her head would be "
                              f"{crown - p.bar:+.2f} m from the bar; use a chain of at least "
                              f"{p.chain + crown - p.bar + HEAD_CLEARANCE:.2f} m")
-    return shift, grips, float(-root[0])
+    return shift, grips
