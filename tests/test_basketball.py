@@ -71,16 +71,36 @@ def test_subcycled_default_follows_the_lock_step_reference(runs, reference):
         assert d < 0.01, f"t={t}: {d:.4f} m from the reference"
 
 
-@pytest.mark.xfail(strict=True, reason="the implicit net converges only to first order in the "
-                   "contact: measured 22 cm off at 1e-3 s (BDF2; 34 cm backward Euler), 8 cm at "
-                   "2e-4 s; see docs/coupling.md and the closing note of issue 2")
-def test_implicit_net_at_1ms_follows_the_reference(reference):
-    r = B.build("two-way", integrator="implicit", dt=1e-3,
-                params=dataclasses.replace(B.BasketballParams(), coupling_dt=1e-3)).simulate(
+def implicit_errors(reference, dt, params=B.BasketballParams()):
+    """The implicit net at step dt (s, the coupling step too): the ball's distance (m) from
+    the reference at every checkpoint."""
+    r = B.build("two-way", integrator="implicit", dt=dt,
+                params=dataclasses.replace(params, coupling_dt=dt)).simulate(
                     refine_unstable=False)
-    for t in CHECK:
-        d = np.linalg.norm(r.state_at("ball", t)[0][:3] - reference.state_at("ball", t)[0][:3])
-        assert d < 0.01
+    return np.array([np.linalg.norm(r.state_at("ball", t)[0][:3]
+                                    - reference.state_at("ball", t)[0][:3]) for t in CHECK])
+
+
+@pytest.mark.xfail(strict=True, reason="with friction 1.0 on the 0.2 g knots the implicit net at "
+                   "1e-3 s ends 4.9 cm from the reference at t = 0.6 s (25 cm before the ball was "
+                   "solved with the knots; frictionless 1.8 cm): docs/coupling.md")
+def test_implicit_net_at_1ms_follows_the_reference(reference):
+    assert implicit_errors(reference, 1e-3).max() < 0.01
+
+
+@pytest.mark.slow
+def test_frictionless_implicit_net_converges_to_first_order():
+    # the ball solved with the knots, no friction: backward Euler is first order in the step,
+    # so from 1e-3 s to 2e-4 s the largest checkpoint error falls ~5x; at least 3x asserted
+    # (measured 1.76 cm -> 0.23 cm). Before, the ball received the contact a step late and
+    # was 19 cm off at 1e-3 s.
+    p = B.BasketballParams()
+    p = dataclasses.replace(p, contact=dataclasses.replace(p.contact, friction=0.0))
+    reference = B.build("two-way", dt=1e-5,
+                        params=dataclasses.replace(p, coupling_dt=1e-5)).simulate()
+    coarse, fine = implicit_errors(reference, 1e-3, p), implicit_errors(reference, 2e-4, p)
+    assert coarse.max() < 0.025  # the issue asks 1 cm with friction; frictionless 1.76 cm
+    assert fine.max() < coarse.max() / 3
 
 
 def test_fit_standin_reproduces_the_default(runs):

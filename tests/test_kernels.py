@@ -121,6 +121,68 @@ def test_implicit_step_matches_dense_solve(theta):
     assert np.all(x1[fixed] == x[fixed])
 
 
+def test_implicit_step_with_a_body_matches_dense_solve():
+    # a free body (a ball) touching two points: its velocity is an unknown of the same
+    # backward Euler solve, each contact a coupling C = h D + h^2 K between point and body
+    x, v, m, si, sj, l0, k, kd, tonly = random_network(seed=8)
+    n = len(x)
+    rng = np.random.default_rng(9)
+    fixed = np.zeros(n, dtype=bool)
+    fixed[0] = True
+    v[fixed] = 0.0
+    g = np.array([0, 0, -9.81])
+    h, M, a_b = 1e-2, 0.7, g
+    v_b = rng.normal(size=3)
+    pts = np.array([3, 7])
+    nrm = [u / np.linalg.norm(u) for u in rng.normal(size=(2, 3))]
+    lf = K.PointForces(pts, rng.normal(size=(2, 3)),
+                       np.array([-800.0 * np.outer(u, u) for u in nrm]),
+                       np.array([-3.0 * np.outer(u, u) for u in nrm]),
+                       np.array([v_b, v_b]))
+    kext, dext = np.zeros((n, 3, 3)), np.zeros((n, 3, 3))
+    fext, kvref = np.zeros((n, 3)), np.zeros((n, 3))
+    for e, i in enumerate(pts):  # the contacts' share of the points' load, as a contact adds it
+        fext[i] += lf.f[e]
+        kext[i] += lf.dfdx[e]
+        dext[i] += lf.dfdv[e]
+        kvref[i] += lf.dfdx[e] @ lf.vref[e]
+    f, Kd, Dd = dense_jacobians(x, v, m, si, sj, l0, k, kd, tonly, 0.2, g, fext, kext, dext)
+    big = 3 * n + 3
+    A = np.zeros((big, big))
+    A[:3 * n, :3 * n] = np.diag(np.repeat(m, 3)) - h * Dd - h * h * Kd
+    A[3 * n:, 3 * n:] = M * np.eye(3)
+    rhs = np.zeros(big)
+    rhs[:3 * n] = h * (f + h * Kd @ v.ravel() - h * kvref.ravel())
+    rhs[3 * n:] = h * M * a_b
+    for e, i in enumerate(pts):
+        C = h * lf.dfdv[e] + h * h * lf.dfdx[e]
+        A[3 * i:3 * i + 3, 3 * n:] += C
+        A[3 * n:, 3 * i:3 * i + 3] += C.T
+        A[3 * n:, 3 * n:] -= C
+        rhs[3 * n:] -= h * (lf.f[e] + lf.dfdx[e] @ (h * v[i] - h * lf.vref[e]))
+    dv_ref = solve_free(A, rhs, np.append(fixed, False))
+    x1, v1 = x.copy(), v.copy()
+    dv_b, flin = np.zeros((1, 3)), np.zeros((2, 3))
+    K.implicit_step_with_bodies(
+        network(x1, v1, m, si, sj, l0, k, kd, tonly, 0.2, g, fixed),
+        K.Load(fext, kext, dext, kvref), np.zeros_like(x), h,
+        scheme(1.0, False, np.zeros_like(x), np.zeros_like(x), 1e-13), False,
+        K.Bodies(np.array([M]), v_b[None].copy(), a_b[None].copy(), np.zeros(2, np.int64), lf,
+                 2, dv_b, flin))
+    # CG to a 1e-13 relative residual: the velocities agree to ~1e-10 of their size
+    scale = np.abs(dv_ref).max()
+    np.testing.assert_allclose(v1 - v, dv_ref[:n], atol=1e-9 * scale)
+    np.testing.assert_allclose(dv_b[0], dv_ref[n], atol=1e-9 * scale)
+    # equal and opposite: the body's momentum change is gravity's impulse minus the points'
+    # linearised contact forces, which are what the points integrated with
+    np.testing.assert_allclose(M * dv_b[0], h * M * a_b - h * flin.sum(axis=0),
+                               atol=1e-9 * M * scale)
+    for e, i in enumerate(pts):
+        want = lf.f[e] + lf.dfdx[e] @ (h * v1[i] - h * lf.vref[e] - h * dv_b[0]) \
+            + lf.dfdv[e] @ (v1[i] - v[i] - dv_b[0])
+        np.testing.assert_allclose(flin[e], want, atol=1e-9 * np.abs(want).max())
+
+
 def test_bdf2_step_matches_dense_solve():
     # BDF2 is the theta-type system with hs = 2h/3 and a right-hand side that remembers the
     # previous step: M (v - vp) / 3 + hs (f + K y), y = (x - xp) / 3 + hs v
@@ -189,9 +251,10 @@ def test_sphere_elements_against_brute_force():
     np.testing.assert_allclose(f[:cnt].sum(axis=0), -wrench[:3], atol=1e-12)
 
 
-def test_subcycled_contact_conserves_momentum():
-    # a free net (no gravity, anchors or damping) hit by a moving sphere: the net's momentum
-    # gain equals the impulse the sphere receives, with opposite sign, to round-off
+def free_net_and_ball():
+    """The basketball's net free in space (no gravity, anchors or damping: its momentum changes
+    only by the contact) and a 0.68 kg ball flying into it: (net bundle, its v (n,3), its
+    masses, cord pairs, the ball as Colliders, zero (n,3) and (n,3,3) arrays)."""
     from interplay.geometry.net import NetParams, net_knots
     x, pairs = net_knots(NetParams())
     n = len(x)
@@ -199,21 +262,46 @@ def test_subcycled_contact_conserves_momentum():
     k = 300.0 / l0
     m = np.full(n, 0.03 / n)
     v = np.zeros_like(x)
-    p0 = (m[:, None] * v).sum(axis=0)
     cols = Colliders(np.array([[0.05, 0.0, 3.05]]), np.array([[0.3, 0.0, -4.0]]),
                      np.zeros((1, 3)), np.zeros((1, 3)), np.array([0.12]), np.array([0.68]),
                      np.array([[0.003, 2e3, 0.5, 1.0, 0.05, 1.0]]), np.zeros((1, 7)))
-    z3 = np.zeros((n, 3))
-    z33 = np.zeros((n, 3, 3))
     net = network(x, v, m, pairs[:, 0].copy(), pairs[:, 1].copy(), l0, k, 2e-4 * k,
                   np.ones(len(l0), bool), 0.0, np.zeros(3))
+    return net, v, m, pairs, cols, np.zeros((n, 3)), np.zeros((n, 3, 3))
+
+
+def test_subcycled_contact_conserves_momentum():
+    # the explicit net's momentum gain equals the impulse the sphere receives, with opposite
+    # sign, to round-off
+    net, v, m, pairs, cols, z3, z33 = free_net_and_ball()
     explicit = K.Scheme(False, 1.0, False, 1e-8, 100, z3, z3)
     total = np.zeros(3)
     for _ in range(100):
-        advance_with_colliders(net, K.Load(z3, z33, z33, z3), np.zeros_like(x), 1e-3, 20,
+        advance_with_colliders(net, K.Load(z3, z33, z33, z3), np.zeros_like(z3), 1e-3, 20,
                                explicit, False, cols, pairs)
         total += cols.impulses[0, :3]
         cols.centres[:] += cols.velocities * 1e-3
-    p1 = (m[:, None] * v).sum(axis=0)
     assert np.linalg.norm(total) > 1e-3  # the sphere really hit the net
-    np.testing.assert_allclose(p1 - p0, -total, atol=1e-12)
+    np.testing.assert_allclose((m[:, None] * v).sum(axis=0), -total, atol=1e-12)
+
+
+@pytest.mark.parametrize("nsub", [1, 4])
+def test_implicit_subcycled_contact_with_a_free_ball_conserves_momentum(nsub):
+    # the implicit net solves the ball's velocity with its knots and hands it minus the
+    # forces the knots integrated with: the net's momentum gain equals minus the ball's
+    # impulse to the CG's 1e-12 residual
+    net, v, m, pairs, cols, z3, z33 = free_net_and_ball()
+    implicit = K.Scheme(True, 1.0, False, 1e-12, 2000, z3.copy(), z3.copy())
+    total = np.zeros(3)
+    h = 1e-3
+    for _ in range(100):
+        advance_with_colliders(net, K.Load(z3, z33, z33, z3), np.zeros_like(z3), h, nsub,
+                               implicit, False, cols, pairs)
+        total += cols.impulses[0, :3]
+        # the ball as its rigid step moves it: the step's mean force, held
+        dv = cols.impulses[0, :3] / 0.68
+        cols.centres[:] += h * (cols.velocities + 0.5 * dv)
+        cols.velocities[:] += dv
+    assert np.linalg.norm(total) > 1e-3  # the ball really hit the net
+    np.testing.assert_allclose((m[:, None] * v).sum(axis=0), -total,
+                               atol=1e-9 * np.linalg.norm(total))

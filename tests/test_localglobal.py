@@ -262,11 +262,9 @@ def test_explicit_subcycled_contact_carries_the_cloth_weight():
     assert np.mean(push[-15:]) == pytest.approx(0.02 * 9.81, rel=0.02)
 
 
-@pytest.mark.xfail(strict=True, reason="the implicit network's sub-cycled contact reports the "
-                   "start-of-substep force as the collider's impulse while its solve applies "
-                   "the force linearised at the substep's end: a settled drape reports 2.3x "
-                   "its weight (the implicit contact of issue 22)")
 def test_implicit_subcycled_contact_carries_the_cloth_weight():
+    # the collider receives the contact forces linearised at the substep's end, the ones the
+    # cloth's solve integrated with (it reported the start-of-substep force: 2.3x the weight)
     _, push = drape_on_sphere("implicit", 1e-3, points=True)
     assert np.mean(push[-15:]) == pytest.approx(0.02 * 9.81, rel=0.02)
 

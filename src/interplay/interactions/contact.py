@@ -93,10 +93,11 @@ class SphereCordContact(Interaction):
     def prepare(self, h, dts=None):
         """When the network takes several substeps per coupling step, the contact is
         sub-cycled inside its kernel against the ball's predicted path, and the ball receives
-        the step's mean force."""
+        the step's mean force; an implicit network (one that takes Jacobians) always takes
+        it there, to solve the ball's velocity with its points."""
         self._h = h
         dt = (dts or {}).get(self.secondary.name, self.secondary.dt)
-        self._subcycle = substeps(h, dt) > 1
+        self._subcycle = substeps(h, dt) > 1 or self.net.jacobians
 
     def exchange(self, to_primary, to_secondary):
         ball = _ball(self.ball, self.radius)

@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .contact_law import friction_damping, normal_force, sliding_friction
+from .contact_law import friction_damping, friction_slope, normal_force, sliding_friction
 
 THICKNESS, STIFFNESS, DAMPING, FRICTION, EPS, CONSTRAINT = range(6)
 
@@ -161,8 +161,8 @@ def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrenc
             wrench[q] += F[q]
             wrench[3 + q] += tau[q]
         # Jacobians of the point forces: penalty along n; damping along n; friction in the
-        # tangent plane (the law's secant damping)
-        visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
+        # tangent plane (the law's slope where it is linear)
+        visc = friction_slope(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
         k = to_segment_ends(out, k, (ia, ib, wa, wb), F, n, vball, (cs, cd, visc),
                             with_jacobian)
     return k
@@ -173,9 +173,9 @@ def to_segment_ends(out, k, ends, F, n, vref, gains, with_jacobian):
     """Write -F (N, the reaction of a contact force F on the other body) to a segment's ends
     (ia, ib, wa, wb: point indices and barycentric weights; one entry when ia == ib) in the
     PointForces ``out`` from entry k, with the Jacobians when ``with_jacobian``: the penalty's
-    c_s and the damping's c_d along the normal n, the friction's secant damping visc in the
-    tangent plane (gains = (c_s, c_d, visc)), relative to the other body's velocity vref.
-    Returns the next free entry."""
+    c_s and the damping's c_d along the normal n, the friction's slope visc in the tangent
+    plane (gains = (c_s, c_d, visc); contact_law.friction_slope), relative to the other
+    body's velocity vref. Returns the next free entry."""
     out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
     ia, ib, wa, wb = ends
     cs, cd, visc = gains

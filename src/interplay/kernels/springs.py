@@ -93,6 +93,26 @@ def point_forces(capacity: int) -> PointForces:
                        np.zeros((capacity, 3)))
 
 
+class Bodies(NamedTuple):
+    """Free rigid bodies solved in one implicit step together with the network: their
+    translation (a ball in a net), so a stiff contact is implicit on both sides, not a force
+    the body receives a step late. mass (k,) kg (not finite or <= 0: prescribed, its path
+    given, not solved); v (k,3) m/s at the step's start; acc (k,3) m/s^2 its acceleration
+    from every other force, held. ``links``: the contacts that couple them to the points, as
+    PointForces entries (the force on point idx[e] from body owner[e] (-1: a prescribed body),
+    its Jacobians relative to that body), ``count`` of them. Receives dv (k,3) m/s, each
+    body's velocity change over the step, and flin (c,3) N, each entry's force linearised at
+    the step's end: the force the point integrated with, so the body's share is -flin."""
+    mass: np.ndarray
+    v: np.ndarray
+    acc: np.ndarray
+    owner: np.ndarray
+    links: PointForces
+    count: int
+    dv: np.ndarray
+    flin: np.ndarray
+
+
 @njit(cache=True, inline="always")
 def _spring_vector(x, a, b):
     """(d0, d1, d2, length) of x[a] - x[b]."""
@@ -200,8 +220,10 @@ def _spring_blocks(x, springs, h, C, Kblk):
 
 
 @njit(cache=True)
-def _apply_A(p, diag, si, sj, C, fixed, out):
-    """out = A p with A = blockdiag(diag) - sum over springs of the +-C couplings; fixed rows 0."""
+def _apply_A(p, diag, si, sj, C, fixed, links, Cl, out):
+    """out = A p with A = blockdiag(diag) - sum over springs of the +-C couplings, plus each
+    body link's coupling Cl between its point links[e, 0] and its body's row links[e, 1]
+    (-1: none); fixed rows 0."""
     n = p.shape[0]
     for i in range(n):
         for r in range(3):
@@ -215,6 +237,15 @@ def _apply_A(p, diag, si, sj, C, fixed, out):
                 y += C[s, r, c] * (p[a, c] - p[b, c])
             out[a, r] -= y
             out[b, r] += y
+    for e in range(links.shape[0]):
+        i = links[e, 0]
+        b = links[e, 1]
+        if b < 0:
+            continue
+        for r in range(3):
+            for c in range(3):
+                out[i, r] += Cl[e, r, c] * p[b, c]
+                out[b, r] += Cl[e, c, r] * p[i, c]
     for i in range(n):
         if fixed[i]:
             out[i, 0] = 0.0
@@ -252,6 +283,17 @@ def _dot(a, b):
 
 @njit(cache=True)
 def implicit_step(net, load, f, h, scheme, has_prev):
+    """One implicit step of the network alone (``implicit_step_with_bodies`` without bodies).
+    Returns the CG iterations."""
+    e3 = np.zeros((0, 3))
+    none = PointForces(np.zeros(0, np.int64), e3, np.zeros((0, 3, 3)), np.zeros((0, 3, 3)), e3)
+    return implicit_step_with_bodies(net, load, f, h, scheme, has_prev,
+                                     Bodies(np.zeros(0), e3, e3, np.zeros(0, np.int64), none, 0,
+                                            e3, e3))
+
+
+@njit(cache=True)
+def implicit_step_with_bodies(net, load, f, h, scheme, has_prev, bodies):
     """One implicit step with one Newton iteration, of the theta-method or of BDF2.
 
     theta-method: (M - theta h D - theta^2 h^2 K) dv = h (f + theta h K v),
@@ -269,8 +311,15 @@ def implicit_step(net, load, f, h, scheme, has_prev):
     blocks, e.g. from penalty contacts), so stiff couplings stay stable at large h. An external
     force that depends on the point's position *relative to another body* moving at v_ref
     (a contact) enters as kext (v - v_ref): kvref (n,3) holds the sum of kext v_ref, so the
-    point follows the other body through the step instead of lagging a step behind. Solved by
-    block-Jacobi preconditioned CG to a relative residual ``tol``. Returns the CG iterations.
+    point follows the other body through the step instead of lagging a step behind.
+
+    ``bodies`` (a Bodies) adds free rigid bodies' velocities to the unknowns: a contact entry
+    e between point i and body b couples them by C_e = hs D_e + hs^2 K_e (K_e, D_e its dfdx,
+    dfdv), the body's row being M_b dv_b = cf (M_b a_b - sum_e f_e,lin), so the contact is
+    implicit on both sides and the exchange equal and opposite. A BDF2 network steps by
+    backward Euler while a body is coupled (the bodies keep no history); BDF2 resumes after.
+    Solved by block-Jacobi preconditioned CG to a relative residual ``tol``. Returns the CG
+    iterations.
     """
     x, v, m, fixed = net.pts
     si, sj = net.springs.i, net.springs.j
@@ -280,11 +329,26 @@ def implicit_step(net, load, f, h, scheme, has_prev):
     _, theta, bdf2, tol, max_iter, xp, vp = scheme
     n = x.shape[0]
     ns = si.shape[0]
+    nb = bodies.mass.shape[0]
+    big = n + nb  # unknowns: the points' velocity changes, then the free bodies'
+    fixed_all = np.ones(big, np.bool_)
+    fixed_all[:n] = fixed
+    for q in range(nb):
+        fixed_all[n + q] = not (np.isfinite(bodies.mass[q]) and bodies.mass[q] > 0.0)
+    nl = bodies.count
+    links = np.full((nl, 2), -1, np.int64)  # (point, body row) of each coupling
+    coupled = False
+    for e in range(nl):
+        links[e, 0] = bodies.links.idx[e]
+        q = bodies.owner[e]
+        if q >= 0 and not fixed_all[n + q]:
+            links[e, 1] = n + q
+            coupled = True
     network_forces(net, fext, f)
     C = np.empty((ns, 3, 3))
     Kblk = np.empty((ns, 3, 3))
-    first = bdf2 and not has_prev
-    if bdf2 and has_prev:
+    first = bdf2 and (not has_prev or coupled)
+    if bdf2 and not first:
         hs, cf, wref, cprev = 2.0 * h / 3.0, 2.0 * h / 3.0, h, 1.0 / 3.0
     else:
         th = 1.0 if first else theta
@@ -299,7 +363,7 @@ def implicit_step(net, load, f, h, scheme, has_prev):
                 hs * v[i, r] + (cprev * (x[i, r] - xp[i, r]) if bdf2 else 0.0))
     _spring_blocks(x, net.springs, hs, C, Kblk)
     # diagonal blocks of A not coming from springs: M - h D_diag - h^2 K_diag
-    diag = np.zeros((n, 3, 3))
+    diag = np.zeros((big, 3, 3))
     for i in range(n):
         for r in range(3):
             for c in range(3):
@@ -311,7 +375,7 @@ def implicit_step(net, load, f, h, scheme, has_prev):
             diag[i, r, r] += hs * a_c[q] + hs * hs * a_k[q]
     # right-hand side b = cprev M (v - vp) + cf (f + K y); external stiffness acts on the
     # displacement relative to the other body, y - wref v_ref
-    b = np.empty((n, 3))
+    b = np.zeros((big, 3))
     for i in range(n):
         for r in range(3):
             kv = 0.0
@@ -333,36 +397,60 @@ def implicit_step(net, load, f, h, scheme, has_prev):
                 kv += Kblk[s, r, c] * (y[a, c] - y[bb, c])
             b[a, r] += cf * kv
             b[bb, r] -= cf * kv
-    # block-Jacobi preconditioner: inverse of each point's full diagonal block
+    # the free bodies' rows: M_b - sum C_e on the diagonal, C_e to each touching point, and
+    # cf (M_b a_b - sum (f_e + K_e (y_i - wref v_ref))) on the right
+    lf = bodies.links
+    Cl = np.zeros((nl, 3, 3))
+    for q in range(nb):
+        if not fixed_all[n + q]:
+            for r in range(3):
+                diag[n + q, r, r] = bodies.mass[q]
+                b[n + q, r] = cf * bodies.mass[q] * bodies.acc[q, r]
+    for e in range(nl):
+        bq = links[e, 1]
+        if bq < 0:
+            continue
+        i = links[e, 0]
+        for r in range(3):
+            kv = lf.f[e, r]
+            for c in range(3):
+                Cl[e, r, c] = hs * lf.dfdv[e, r, c] + hs * hs * lf.dfdx[e, r, c]
+                diag[bq, r, c] -= hs * lf.dfdv[e, r, c] + hs * hs * lf.dfdx[e, r, c]
+                kv += lf.dfdx[e, r, c] * (y[i, c] - wref * lf.vref[e, c])
+            b[bq, r] -= cf * kv
+    # block-Jacobi preconditioner: inverse of each row's full diagonal block
     P = diag.copy()
     for s in range(ns):
         for r in range(3):
             for c in range(3):
                 P[si[s], r, c] -= C[s, r, c]
                 P[sj[s], r, c] -= C[s, r, c]
-    Pinv = np.empty((n, 3, 3))
-    for i in range(n):
+    Pinv = np.empty((big, 3, 3))
+    for i in range(big):
+        if fixed_all[i]:
+            Pinv[i] = 0.0
+            continue
         inv3(P[i], Pinv[i])
-    for i in range(n):
-        if fixed[i]:
+    for i in range(big):
+        if fixed_all[i]:
             b[i, 0] = 0.0
             b[i, 1] = 0.0
             b[i, 2] = 0.0
     # preconditioned conjugate gradients with the constraint filter
-    dv = np.zeros((n, 3))
+    dv = np.zeros((big, 3))
     r_ = b.copy()
-    z = np.empty((n, 3))
+    z = np.empty((big, 3))
     _precondition(Pinv, r_, z)
     pdir = z.copy()
-    Ap = np.empty((n, 3))
+    Ap = np.empty((big, 3))
     rz = _dot(r_, z)
     bnorm = np.sqrt(_dot(b, b))
     it = 0
     if bnorm > 0.0:
         while it < max_iter:
-            _apply_A(pdir, diag, si, sj, C, fixed, Ap)
+            _apply_A(pdir, diag, si, sj, C, fixed_all, links, Cl, Ap)
             alpha_cg = rz / _dot(pdir, Ap)
-            for i in range(n):
+            for i in range(big):
                 for a in range(3):
                     dv[i, a] += alpha_cg * pdir[i, a]
                     r_[i, a] -= alpha_cg * Ap[i, a]
@@ -372,7 +460,7 @@ def implicit_step(net, load, f, h, scheme, has_prev):
             _precondition(Pinv, r_, z)
             rz_new = _dot(r_, z)
             beta = rz_new / rz
-            for i in range(n):
+            for i in range(big):
                 for a in range(3):
                     pdir[i, a] = z[i, a] + beta * pdir[i, a]
             rz = rz_new
@@ -391,6 +479,21 @@ def implicit_step(net, load, f, h, scheme, has_prev):
                     vp[i, c] = v[i, c]
                 x[i, c] += h * v[i, c] + hs * dv[i, c]
             v[i, c] += dv[i, c]
+    for q in range(nb):
+        for c in range(3):
+            bodies.dv[q, c] = dv[n + q, c]
+    # each link's force as the point integrated it: f + K (y + hs dv - wref v_ref - hs dv_b)
+    # + D (dv - dv_b), y and dv the point's (0 for a fixed one), dv_b the body's (0: prescribed)
+    for e in range(nl):
+        i = links[e, 0]
+        bq = links[e, 1]
+        for r in range(3):
+            fl = lf.f[e, r]
+            for c in range(3):
+                dvb = dv[bq, c] if bq >= 0 else 0.0
+                fl += (lf.dfdx[e, r, c] * (y[i, c] + hs * (dv[i, c] - dvb) - wref * lf.vref[e, c])
+                       + lf.dfdv[e, r, c] * (dv[i, c] - dvb))
+            bodies.flin[e, r] = fl
     return it
 
 

@@ -8,13 +8,21 @@ the one contact law, accumulating the impulse each collider received. The intera
 applies impulse / h to its rigid side, so the exchange is equal and opposite over the step and
 momentum is conserved exactly, while the light, stiff network is integrated at its own small
 step without a Python call per substep. The network knows nothing of what the colliders are.
+
+An implicit network solves its free colliders (finite mass) with its points instead
+(kernels.springs.implicit_step_with_bodies): their velocities are unknowns of the substep's
+solve, they move by the solve (with the points' scheme), not along the predicted path, and each
+receives the contact forces linearised at the substep's end, the forces its points
+integrated with; so the contact is implicit on both sides and converges with the substep
+(the basketball's implicit net at 1 ms, docs/coupling.md).
 """
 import numpy as np
 from numba import njit
 
 from .contact import Sphere, sphere_elements, THICKNESS
 from .part_contact import Touches, find_touches, touch_forces
-from .springs import Load, PointForces, implicit_step, network_forces, symplectic_update
+from .springs import (Bodies, Load, PointForces, implicit_step, implicit_step_with_bodies,
+                      network_forces, symplectic_update)
 
 
 @njit(cache=True)
@@ -38,14 +46,38 @@ def _scatter(out, count, f, load, implicit):
 
 
 @njit(cache=True)
+def _settle_links(links, src, flin, count, x0, at, dt, impulses):
+    """Correct each collider's impulse and angular impulse (accumulated with the contact
+    forces at the substep's start) to the forces linearised at its end, flin, which its
+    points integrated with: the exchange stays equal and opposite. The correction's lever is
+    the point's start position from the collider's centre, which stands in for the contact
+    point's (a cord's end is within the cord's length of it) in the correction only: the
+    start forces' torque is exact."""
+    for e in range(count):
+        q = src[e]
+        i = links.idx[e]
+        d0 = links.f[e, 0] - flin[e, 0]  # the collider's share: minus the point's force
+        d1 = links.f[e, 1] - flin[e, 1]
+        d2 = links.f[e, 2] - flin[e, 2]
+        r0, r1, r2 = x0[i, 0] - at[q, 0], x0[i, 1] - at[q, 1], x0[i, 2] - at[q, 2]
+        impulses[q, 0] += d0 * dt
+        impulses[q, 1] += d1 * dt
+        impulses[q, 2] += d2 * dt
+        impulses[q, 3] += (r1 * d2 - r2 * d1) * dt
+        impulses[q, 4] += (r2 * d0 - r0 * d2) * dt
+        impulses[q, 5] += (r0 * d1 - r1 * d0) * dt
+
+
+@njit(cache=True)
 def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems):
     """Advance the Network by h in nsub substeps, the Colliders ``cols`` against its elements
     ``elems`` (segments (s,2), or points as (p, p) pairs) re-evaluated every substep.
 
     load: the other external forces (a Load, held constant); scheme: explicit or implicit (a
-    Scheme; the contacts then add their Jacobians to the load of each substep); has_prev:
-    whether BDF2 has a previous state. cols.impulses receives the impulse (0:3, N s), angular
-    impulse (3:6, N m s) and the peak force (6, N) of each collider over the step.
+    Scheme; the contacts then add their Jacobians to the load of each substep, and free
+    colliders are solved with the points: the module docstring); has_prev: whether BDF2 has a
+    previous state. cols.impulses receives the impulse (0:3, N s), angular impulse (3:6,
+    N m s) and the peak force (6, N) of each collider over the step.
     """
     x = net.pts.x
     m = net.pts.m
@@ -69,6 +101,20 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
     for q in range(impulses.shape[0]):
         for r in range(7):
             impulses[q, r] = 0.0
+    # the implicit substep's contacts, each collider's entries one after the other: src the
+    # collider, owner the same when it is solved with the points (finite mass), else -1
+    k_cols = cols.centres.shape[0]
+    cap = 2 * ne * k_cols if implicit else 0
+    links = PointForces(np.zeros(cap, np.int64), np.zeros((cap, 3)), np.zeros((cap, 3, 3)),
+                        np.zeros((cap, 3, 3)), np.zeros((cap, 3)))
+    owner = np.full(cap, -1, np.int64)
+    src = np.zeros(cap, np.int64)
+    flin = np.zeros((cap, 3))
+    body_c = cols.centres.copy()  # the solved colliders' state through the substeps
+    body_v = cols.velocities.copy()
+    body_dv = np.zeros((k_cols, 3))
+    at = np.empty((k_cols, 3))  # each collider's centre at the substep's start
+    x0 = np.empty_like(x)
     for step in range(nsub):
         tau = step * dt
         network_forces(net, load.f, f)
@@ -85,11 +131,17 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
             de[:] = load.dext
             kv[:] = load.kvref
         have_acc = False
-        for q in range(cols.centres.shape[0]):
+        count = 0
+        for q in range(k_cols):
+            solved = implicit and np.isfinite(cols.masses[q]) and cols.masses[q] > 0.0
             far = False
             for r in range(3):
-                c[r] = (cols.centres[q, r] + cols.velocities[q, r] * tau
-                        + 0.5 * cols.accels[q, r] * tau * tau)
+                if solved:
+                    c[r] = body_c[q, r]
+                else:
+                    c[r] = (cols.centres[q, r] + cols.velocities[q, r] * tau
+                            + 0.5 * cols.accels[q, r] * tau * tau)
+                at[q, r] = c[r]
                 reach = cols.radii[q] + cols.law[q, THICKNESS]
                 if c[r] + reach < lo[r] or c[r] - reach > hi[r]:
                     far = True
@@ -100,7 +152,10 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
                     for r in range(3):
                         acc[i, r] = f[i, r] / m[i]
                 have_acc = True
-            vq = cols.velocities[q] + cols.accels[q] * tau
+            if solved:
+                vq = body_v[q].copy()
+            else:
+                vq = cols.velocities[q] + cols.accels[q] * tau
             ball = Sphere(c, vq, cols.spins[q], cols.radii[q], cols.masses[q], cols.accels[q])
             cnt = sphere_elements(ball, net.pts, acc, elems, cols.law[q], dt, out, implicit,
                                   wrench)
@@ -110,8 +165,28 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
             if fmag > impulses[q, 6]:
                 impulses[q, 6] = fmag
             _scatter(out, cnt, f, sub_load, implicit)
+            for e in range(cnt if implicit else 0):
+                links.idx[count] = out.idx[e]
+                links.f[count] = out.f[e]
+                links.dfdx[count] = out.dfdx[e]
+                links.dfdv[count] = out.dfdv[e]
+                links.vref[count] = out.vref[e]
+                owner[count] = q if solved else -1
+                src[count] = q
+                count += 1
         if implicit:
-            implicit_step(net, sub_load, f, dt, scheme, has_prev or step > 0)
+            x0[:] = x
+            implicit_step_with_bodies(net, sub_load, f, dt, scheme, has_prev or step > 0,
+                                      Bodies(cols.masses, body_v, cols.accels, owner, links,
+                                             count, body_dv, flin))
+            _settle_links(links, src, flin, count, x0, at, dt, impulses)
+            # the solved colliders move as the points do: x += h (v + theta dv), a coupled
+            # BDF2 step being backward Euler
+            th = 1.0 if scheme.bdf2 else scheme.theta
+            for q in range(k_cols):
+                for r in range(3):
+                    body_c[q, r] += dt * (body_v[q, r] + th * body_dv[q, r])
+                    body_v[q, r] += body_dv[q, r]
         else:
             # symplectic Euler on the forces already evaluated (internal, held, contacts)
             symplectic_update(net.pts, f, dt)
