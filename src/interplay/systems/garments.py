@@ -148,8 +148,8 @@ class Garments(SpringNetwork):
     def frame(self):
         if self._skin is not None:
             cert = self.certify(self.time)
-            # one certificate per time: the scheduler's cost estimate asks for a frame before
-            # the pass, when a simulated wearer may not yet be where the cloth's time says
+            # one certificate per time, the latest: the scheduler's cost estimate asks for a
+            # frame before the passes, and the pass's own frame at that time follows
             if self.certificates and self.certificates[-1]["t"] == cert["t"]:
                 self.certificates[-1] = cert
             else:
