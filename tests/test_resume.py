@@ -60,7 +60,7 @@ CASES = {"basketball": ("hybrid", 0.3), "bungee": ("two-way", 0.4), "flags": ("o
          "leaves": ("one-way", 0.2), "pond": ("two-way", 0.2), "puddle": ("one-way", 0.2),
          "diver": ("hybrid", 0.3), "kites": ("two-way", 0.2), "stunt_kite": ("two-way", 0.2),
          "trampoline": ("two-way", 0.6), "owl_creek": ("two-way", 0.3),
-         "runner": ("one-way", 0.2), "mat": ("hybrid", 0.3)}
+         "runner": ("one-way", 0.2), "mat": ("hybrid", 0.3), "swing": ("one-way", 0.2)}
 
 
 @pytest.mark.parametrize("name", MODULES)

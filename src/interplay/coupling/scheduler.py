@@ -428,6 +428,11 @@ class Runner:
         for k in range(st.k, n + 1):
             t = k * h
             resumed_here = k == first and self.resumed_step
+            # played systems are where their tracks say before anything reads them: a live
+            # system's frame may depend on one (a garment certified against a played body)
+            for s, tr in played_tracks:
+                s.set_generalized_state(*tr.sample(t))
+                s.time = t
             if not resumed_here and (t >= st.next_frame * frame_dt - 1e-9 * h or k == n):
                 while st.next_frame * frame_dt <= t + 0.5 * h:
                     st.next_frame += 1
@@ -442,9 +447,6 @@ class Runner:
                 st.k = k
                 p.wall_s = elapsed()
                 self.save()
-            for s, tr in played_tracks:
-                s.set_generalized_state(*tr.sample(t))
-                s.time = t
             for s in live:
                 s.clear_forces()
             for it, role, log in actions:

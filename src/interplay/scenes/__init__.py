@@ -7,7 +7,7 @@ from ..errors import SceneError
 
 #: the scene modules, loaded on demand (a scene's module imports its systems)
 MODULES = ("basketball", "bungee", "diver", "flags", "kites", "leaves", "mat", "owl_creek",
-           "pond", "puddle", "runner", "stunt_kite", "trampoline")
+           "pond", "puddle", "runner", "stunt_kite", "swing", "trampoline")
 
 
 def spec(name: str):

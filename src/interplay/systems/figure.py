@@ -73,13 +73,17 @@ class Figure(System, RigidParts):
 
     feedback: None, or an object with ``offsets(figure, sensors) -> (joints,)`` rad added to
     the targets at every control tick (a scene's own balance law: control/bounce.py) and
-    ``capture()`` / ``restore(snap)`` of its memory as plain arrays."""
+    ``capture()`` / ``restore(snap)`` of its memory as plain arrays.
+
+    extend: None, or ``extend(spec, bodies)`` adding a scene's own bodies to her MuJoCo model
+    (figure_model.build_model; the swing she sits on, systems/swing.py); her mass is her
+    segments' alone."""
 
     integrator = "MuJoCo implicitfast, PD servo actuators"
 
     def __init__(self, name: str, params: FigureParams = FigureParams(),
                  controller: Controller | None = None, fixed_base: bool = False,
-                 gravity: bool = True, feedback=None):
+                 gravity: bool = True, feedback=None, extend=None):
         super().__init__(name, params.dt)
         import mujoco
         self._mj = mujoco
@@ -93,7 +97,7 @@ class Figure(System, RigidParts):
         self.model = build_model(self.plan, params.environment, params.dt,
                                  root=pos + [0.0, 0.0, 5e-4], yaw=params.yaw,
                                  fixed_base=fixed_base, gravity=gravity,
-                                 mass=params.body.mass)
+                                 mass=params.body.mass, extend=extend)
         m = self.model
         self.data = mujoco.MjData(m)
         self.free = not fixed_base
@@ -127,7 +131,7 @@ class Figure(System, RigidParts):
         self.inertia_distal = axis_inertias(m, self.data, jid, sub) + m.dof_armature[self.vadr]
         self.inertia_support = (axis_inertias(m, self.data, jid, world & ~sub)
                                 + m.dof_armature[self.vadr])
-        self._mass = float(m.body_mass.sum())
+        self._mass = float(m.body_mass[self.seg_body].sum())  # hers, not what ``extend`` added
         self.targets = np.zeros(len(jid))
         self.vtargets = np.zeros(len(jid))
         self.omega = np.full(len(jid), require_positive(name, "omega", params.omega, "rad/s"))

@@ -47,9 +47,12 @@ def joint_group(name: str) -> str:
 
 
 def build_model(plan: list[Segment], env: EnvironmentParams, dt: float, root=(0.0, 0.0, 0.0),
-                yaw: float = 0.0, fixed_base: bool = False, gravity: bool = True, mass=None):
+                yaw: float = 0.0, fixed_base: bool = False, gravity: bool = True, mass=None,
+                extend=None):
     """Compile the figure; root: where the pelvis's rest position is carried to (m), yaw (rad)
-    about +z; fixed_base: weld the pelvis to the world (servo tests)."""
+    about +z; fixed_base: weld the pelvis to the world (servo tests); extend: None, or
+    ``extend(spec, bodies)`` adding bodies and constraints of its own after the figure's
+    (a swing she sits on: systems/swing.py), bodies the figure's by segment name."""
     import mujoco
     spec = mujoco.MjSpec()
     spec.compiler.degree = False
@@ -119,6 +122,8 @@ def build_model(plan: list[Segment], env: EnvironmentParams, dt: float, root=(0.
         else:
             body.add_geom(name=seg.name, type=mujoco.mjtGeom.mjGEOM_SPHERE,
                           size=[seg.shape[1], 0.0, 0.0], pos=seg.shape[2], mass=seg.mass, **gkw)
+    if extend is not None:
+        extend(spec, bodies)
     return spec.compile()
 
 
