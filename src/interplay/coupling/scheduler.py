@@ -163,8 +163,7 @@ def estimate(passes, duration, fps, coupling_dt) -> dict:
             sub = n * max(1.0, math.ceil(h / p.dts[s.name] - 1e-9))
             row["substeps"][s.name] = sub
             row["work"] += sub * max(dof, 1)
-            size = sum(np.asarray(v).size for v in s.frame().values())
-            out["bytes"] += 8.0 * size * min(frames, n + 1)
+            out["bytes"] += 8.0 * s.frame_size() * min(frames, n + 1)
         for s in p.record:
             out["bytes"] += 16.0 * s.generalized_state()[0].size * (n + 1)
         out["bytes"] += 80.0 * len(p.actions) * n

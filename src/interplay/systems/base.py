@@ -136,6 +136,12 @@ class System(ABC):
     def frame(self) -> dict[str, np.ndarray]:
         """What an output frame records (positions of a surface, or a pose)."""
 
+    def frame_size(self) -> int:
+        """How many values an output frame holds, for the run's cost estimate before any step;
+        a system whose ``frame`` does more than read its state (a garment certifies itself
+        there) answers without it."""
+        return sum(np.asarray(v).size for v in self.frame().values())
+
     def capture(self) -> dict[str, np.ndarray]:
         """All of the system's memory as plain arrays (checkpoints, pass reruns): restoring it
         and advancing repeats the same steps bit for bit. Subclasses with solver memory

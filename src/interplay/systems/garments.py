@@ -147,14 +147,12 @@ class Garments(SpringNetwork):
 
     def frame(self):
         if self._skin is not None:
-            cert = self.certify(self.time)
-            # one certificate per time, the latest: the scheduler's cost estimate asks for a
-            # frame before the passes, and the pass's own frame at that time follows
-            if self.certificates and self.certificates[-1]["t"] == cert["t"]:
-                self.certificates[-1] = cert
-            else:
-                self.certificates.append(cert)
+            self.certificates.append(self.certify(self.time))
         return super().frame()
+
+    def frame_size(self) -> int:
+        # the network's frame, without a certificate: the estimate is not a frame
+        return sum(np.asarray(v).size for v in super().frame().values())
 
     def extra_diagnostics(self) -> dict:
         out = dict(super().extra_diagnostics())
