@@ -101,7 +101,7 @@ class Bodies(NamedTuple):
     from every other force, held. ``links``: the contacts that couple them to the points, as
     PointForces entries (the force on point idx[e] from body owner[e] (-1: a prescribed body),
     its Jacobians relative to that body), ``count`` of them. Receives dv (k,3) m/s, each
-    body's velocity change over the step, and flin (c,3) N, each entry's force linearised at
+    body's velocity change over the step (h acc for one that touches no point), and flin (c,3) N, each entry's force linearised at
     the step's end: the force the point integrated with, so the body's share is -flin."""
     mass: np.ndarray
     v: np.ndarray
@@ -330,19 +330,18 @@ def implicit_step_with_bodies(net, load, f, h, scheme, has_prev, bodies):
     n = x.shape[0]
     ns = si.shape[0]
     nb = bodies.mass.shape[0]
-    big = n + nb  # unknowns: the points' velocity changes, then the free bodies'
-    fixed_all = np.ones(big, np.bool_)
+    big = n + nb  # unknowns: the points' velocity changes, then the coupled free bodies'
+    fixed_all = np.ones(big, np.bool_)  # a body's row is solved only while it touches
     fixed_all[:n] = fixed
-    for q in range(nb):
-        fixed_all[n + q] = not (np.isfinite(bodies.mass[q]) and bodies.mass[q] > 0.0)
     nl = bodies.count
     links = np.full((nl, 2), -1, np.int64)  # (point, body row) of each coupling
     coupled = False
     for e in range(nl):
         links[e, 0] = bodies.links.idx[e]
         q = bodies.owner[e]
-        if q >= 0 and not fixed_all[n + q]:
+        if q >= 0 and np.isfinite(bodies.mass[q]) and bodies.mass[q] > 0.0:
             links[e, 1] = n + q
+            fixed_all[n + q] = False
             coupled = True
     network_forces(net, fext, f)
     C = np.empty((ns, 3, 3))
@@ -479,9 +478,9 @@ def implicit_step_with_bodies(net, load, f, h, scheme, has_prev, bodies):
                     vp[i, c] = v[i, c]
                 x[i, c] += h * v[i, c] + hs * dv[i, c]
             v[i, c] += dv[i, c]
-    for q in range(nb):
+    for q in range(nb):  # a body touching nothing falls freely over the step
         for c in range(3):
-            bodies.dv[q, c] = dv[n + q, c]
+            bodies.dv[q, c] = h * bodies.acc[q, c] if fixed_all[n + q] else dv[n + q, c]
     # each link's force as the point integrated it: f + K (y + hs dv - wref v_ref - hs dv_b)
     # + D (dv - dv_b), y and dv the point's (0 for a fixed one), dv_b the body's (0: prescribed)
     for e in range(nl):
