@@ -182,14 +182,14 @@ def _local_sd(l0, l1, l2, h0, h1, h2):
 
 
 @njit(cache=True)
-def _box_sd(C, R, half, px, py, pz, g):
-    """Signed distance (m) of point p from a box (centre C, rotation R, half extents) and the
-    outward unit normal there, in the world, into g."""
+def _box_sd(C, R, h0, h1, h2, px, py, pz, g):
+    """Signed distance (m) of point p from a box (centre C, rotation R, half extents h0, h1,
+    h2) and the outward unit normal there, in the world, into g."""
     dx, dy, dz = px - C[0], py - C[1], pz - C[2]
     l0 = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz
     l1 = R[0, 1] * dx + R[1, 1] * dy + R[2, 1] * dz
     l2 = R[0, 2] * dx + R[1, 2] * dy + R[2, 2] * dz
-    q0, q1, q2 = abs(l0) - half[0], abs(l1) - half[1], abs(l2) - half[2]
+    q0, q1, q2 = abs(l0) - h0, abs(l1) - h1, abs(l2) - h2
     if q0 > 0.0 or q1 > 0.0 or q2 > 0.0:
         e0, e1, e2 = max(q0, 0.0), max(q1, 0.0), max(q2, 0.0)
         d = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
@@ -231,8 +231,6 @@ def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
         # rounding: its signed distance the inner box's less the rounding, the same normal
         rnd = q[0]
         h0, h1, h2 = size[0] - rnd, size[1] - rnd, size[2] - rnd
-        inner = np.empty(3)
-        inner[0], inner[1], inner[2] = h0, h1, h2
         t = 0.0
         if ia != ib:
             lo, hi = 0.0, 1.0
@@ -260,7 +258,7 @@ def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
                 t = 1.0
         for r in range(3):
             X[r] = xa[r] + t * (xb[r] - xa[r])
-        s = _box_sd(A, R, inner, X[0], X[1], X[2], n) - rnd
+        s = _box_sd(A, R, h0, h1, h2, X[0], X[1], X[2], n) - rnd
         for r in range(3):
             P[r] = X[r] - s * n[r]  # the box's surface point nearest X
             n[r] = -n[r]  # outward from the box points at the element: flip to element -> part
