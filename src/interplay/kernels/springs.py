@@ -99,10 +99,11 @@ class Bodies(NamedTuple):
     the body receives a step late. mass (k,) kg (not finite or <= 0: prescribed, its path
     given, not solved); v (k,3) m/s at the step's start; acc (k,3) m/s^2 its acceleration
     from every other force, held. ``links``: the contacts that couple them to the points, as
-    PointForces entries (the force on point idx[e] from body owner[e] (-1: a prescribed body),
-    its Jacobians relative to that body), ``count`` of them. Receives dv (k,3) m/s, each
-    body's velocity change over the step (h acc for one that touches no point), and flin (c,3) N, each entry's force linearised at
-    the step's end: the force the point integrated with, so the body's share is -flin."""
+    PointForces entries (the force on point idx[e] from body owner[e], its Jacobians relative
+    to that body), ``count`` of them. Receives dv (k,3) m/s, each body's velocity change over
+    the step (h acc for one that touches no point), and flin (c,3) N, each entry's force
+    linearised at the step's end: the force the point integrated with, so the body's share
+    is -flin."""
     mass: np.ndarray
     v: np.ndarray
     acc: np.ndarray
@@ -339,7 +340,7 @@ def implicit_step_with_bodies(net, load, f, h, scheme, has_prev, bodies):
     for e in range(nl):
         links[e, 0] = bodies.links.idx[e]
         q = bodies.owner[e]
-        if q >= 0 and np.isfinite(bodies.mass[q]) and bodies.mass[q] > 0.0:
+        if np.isfinite(bodies.mass[q]) and bodies.mass[q] > 0.0:
             links[e, 1] = n + q
             fixed_all[n + q] = False
             coupled = True
@@ -414,7 +415,7 @@ def implicit_step_with_bodies(net, load, f, h, scheme, has_prev, bodies):
             kv = lf.f[e, r]
             for c in range(3):
                 Cl[e, r, c] = hs * lf.dfdv[e, r, c] + hs * hs * lf.dfdx[e, r, c]
-                diag[bq, r, c] -= hs * lf.dfdv[e, r, c] + hs * hs * lf.dfdx[e, r, c]
+                diag[bq, r, c] -= Cl[e, r, c]
                 kv += lf.dfdx[e, r, c] * (y[i, c] - wref * lf.vref[e, c])
             b[bq, r] -= cf * kv
     # block-Jacobi preconditioner: inverse of each row's full diagonal block

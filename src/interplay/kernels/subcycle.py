@@ -101,13 +101,12 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
     for q in range(impulses.shape[0]):
         for r in range(7):
             impulses[q, r] = 0.0
-    # the implicit substep's contacts, each collider's entries one after the other: src the
-    # collider, owner the same when it is solved with the points (finite mass), else -1
+    # the implicit substep's contacts, each collider's entries one after the other, src[e]
+    # the collider of entry e (the solve couples those of finite mass)
     k_cols = cols.centres.shape[0]
     cap = 2 * ne * k_cols if implicit else 0
     links = PointForces(np.zeros(cap, np.int64), np.zeros((cap, 3)), np.zeros((cap, 3, 3)),
                         np.zeros((cap, 3, 3)), np.zeros((cap, 3)))
-    owner = np.full(cap, -1, np.int64)
     src = np.zeros(cap, np.int64)
     flin = np.zeros((cap, 3))
     body_c = cols.centres.copy()  # the solved colliders' state through the substeps
@@ -171,13 +170,12 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
                 links.dfdx[count] = out.dfdx[e]
                 links.dfdv[count] = out.dfdv[e]
                 links.vref[count] = out.vref[e]
-                owner[count] = q if solved else -1
                 src[count] = q
                 count += 1
         if implicit:
             x0[:] = x
             implicit_step_with_bodies(net, sub_load, f, dt, scheme, has_prev or step > 0,
-                                      Bodies(cols.masses, body_v, cols.accels, owner, links,
+                                      Bodies(cols.masses, body_v, cols.accels, src, links,
                                              count, body_dv, flin))
             _settle_links(links, src, flin, count, x0, at, dt, impulses)
             # the solved colliders move as the points do: x += h (v + theta dv), a coupled
