@@ -84,6 +84,15 @@ def resolve(key: str, names: list[str]) -> np.ndarray:
     return np.array(hits, dtype=np.int64)
 
 
+def pose_vector(pairs, names) -> np.ndarray:
+    """Joint values (rad) of a pose given as (joint key, value) pairs, as a state's pose is:
+    one per joint in ``names``, 0 for joints the pose leaves out."""
+    q = np.zeros(len(names))
+    idx, val = _pairs(pairs, list(names), "pose", "pose")
+    q[idx] = val
+    return q
+
+
 @dataclass
 class _Compiled:
     name: str

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..params import param
-from .fsm import resolve
+from .fsm import pose_vector
 
 #: lean back with the legs out (rad), relative to the seated pose (systems/swing.SEATED):
 #: the hips open so the trunk tips back on the seat, the knees straighten, the arms reach up
@@ -55,14 +55,8 @@ class Pump:
             raise ParameterError(f"pump: blend {p.blend} s must be > 0 (the time she takes "
                                  "from one pose to the other), e.g. 0.35")
         self.p = p
-        names = list(joints)
-        self.delta = np.zeros(len(names))  # lean pose minus tuck pose
-        for pose, sign in ((LEAN, 1.0), (TUCK, -1.0)):
-            for key, v in pose:
-                self.delta[resolve(key, names)] += sign * p.scale * v
-        self.tuck = np.zeros(len(names))
-        for key, v in TUCK:
-            self.tuck[resolve(key, names)] = p.scale * v
+        self.tuck = p.scale * pose_vector(TUCK, joints)
+        self.delta = p.scale * pose_vector(LEAN, joints) - self.tuck  # lean minus tuck
         self.s = 0.0  # 0 tucked .. 1 leaning back
         self.leaning = False
 

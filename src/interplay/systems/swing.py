@@ -15,10 +15,11 @@ together in every MuJoCo step.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..control.fsm import pose_vector
 from ..errors import ParameterError, require_positive
 from ..geometry.anthropometry import SEGMENTS
 from ..geometry.setpieces import box, merge, rod
@@ -96,7 +97,7 @@ class SwingFigure(Figure):
                  controller=None, feedback=None):
         self.swing = swing
         root, hands = _seated(params, swing)
-        params = FigureParams(**{**params.__dict__, "position": tuple(root)})
+        params = replace(params, position=tuple(root))
 
         def extend(spec, bodies):
             import mujoco
@@ -120,7 +121,7 @@ class SwingFigure(Figure):
         joint angles, the whole body turned with the swing about the bar."""
         import mujoco
         d = self.data
-        q = _pose_vector(self.joints)
+        q = pose_vector(SEATED, self.joints)
         d.qpos[self.qadr] = q
         pivot = np.array([0.0, 0.0, self.swing.bar])
         c, s = np.cos(angle), np.sin(angle)
@@ -189,14 +190,6 @@ def _palm(plan, hand: str) -> np.ndarray:
     return 0.5 * np.asarray(seg.bone, float)
 
 
-def _pose_vector(joints) -> np.ndarray:
-    from ..control.fsm import resolve
-    q = np.zeros(len(joints))
-    for key, v in SEATED:
-        q[resolve(key, list(joints))] = v
-    return q
-
-
 def _seated(params: FigureParams, p: SwingParams):
     """Where she sits on the swing hanging still: (her Figure position (m): where her pelvis's
     rest position is carried to, grip points (2,3) m on her hands). Her thighs rest on the
@@ -209,7 +202,7 @@ def _seated(params: FigureParams, p: SwingParams):
     data = mujoco.MjData(model)
     names = joint_names(plan)
     jid = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in names]
-    data.qpos[model.jnt_qposadr[jid]] = _pose_vector(names)
+    data.qpos[model.jnt_qposadr[jid]] = pose_vector(SEATED, names)
     mujoco.mj_kinematics(model, data)
     body = {s: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, s) for s in SEGMENTS}
     grips = np.array([data.xpos[body[h]] + data.xmat[body[h]].reshape(3, 3) @ _palm(plan, h)
