@@ -16,9 +16,9 @@ foam's (docs/mat.md), so it keeps the network's small stiffness-proportional bet
 
 Calibration (docs/mat.md): Pain, Mills & Yeadon (2005, Med. Sci. Sports Exerc. 37) dropped a
 24 kg impactor on a competition landing mat and measured 0.088-0.118 m of deformation; the
-modulus below puts this lattice's deformation under that impactor in the band
-(``impactor_drop``), and its measured load-deflection under two feet is what the hybrid
-stand-in is fitted to (``load_deflection``).
+modulus below puts this lattice's deformation under that impactor in the band by a 3 m drop
+(scenes/mat_impact.drop_test), and its measured load-deflection under a rigid sole and its
+impactor drops are what the hybrid stand-in is fitted to (scenes/mat.fit).
 """
 from __future__ import annotations
 
