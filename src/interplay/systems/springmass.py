@@ -2,8 +2,9 @@
 
 Point masses joined by linear springs, with Rayleigh damping (mass-proportional -alpha m v and
 stiffness-proportional along each spring, kd = beta k) plus any spring's own viscosity (a
-group of springs damped beyond beta: a foam's, not its stiff cover's), optional tension-only cords, points
-fixed in place (constraint filter) and points tied to world positions by anchor springs.
+group of springs damped beyond beta: a foam's, not its stiff cover's), optional tension-only
+cords, points fixed in place (constraint filter) and points tied to world positions by anchor
+springs.
 Three integrators: ``explicit`` (symplectic Euler, the reference), ``implicit`` (backward
 Euler, one Newton step, preconditioned CG; Baraff & Witkin 1998) and ``localglobal`` (Liu et
 al. 2013: a prefactored constant matrix and per-spring projections; ``kernels/localglobal.py``).
