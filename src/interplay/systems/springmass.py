@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
@@ -29,6 +27,7 @@ from ..kernels.part_contact import Parts
 from ..kernels.subcycle import advance_with_colliders, advance_with_parts
 from .base import GRAVITY, System, substeps
 from .shape import Shape, split_color
+from .spring_set import Springs  # noqa: F401 (networks are built from it: springmass.Springs)
 from .views import PointsView
 
 INTEGRATORS = ("explicit", "implicit", "localglobal")
@@ -38,41 +37,6 @@ LG_SOLVERS = ("auto", "direct", "multigrid")
 # 0.16 ms against 0.37 ms for the factored solve, at 32^2 they are even, and the factor's cost
 # grows as n^1.25)
 MULTIGRID_MIN_POINTS = 4000
-
-
-@dataclass(frozen=True)
-class Springs:
-    """A set of springs between points i and j.
-
-    rest: rest length (m); stiffness: N/m; tension_only: cords that go slack when compressed.
-    A negative rest length is a preloaded extension spring (a coil spring wound with initial
-    tension, as a trampoline's): it pulls k (l - rest) at every length l, k |rest| even at
-    zero length, so it is never slack; only springs that are not tension-only may have one,
-    and the strain measure leaves them out.
-    """
-    i: np.ndarray
-    j: np.ndarray
-    rest: np.ndarray
-    stiffness: np.ndarray
-    tension_only: np.ndarray
-
-    @staticmethod
-    def from_ratio(x, pairs, stress_strain: float, tension_only: bool = False) -> "Springs":
-        """Springs on index pairs at their current lengths, k = (stress/strain ratio) / l0.
-
-        stress_strain: force per unit strain (N), e.g. E*A for a cord; independent of resolution.
-        """
-        pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
-        rest = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
-        with np.errstate(divide="ignore"):  # zero lengths are reported by SpringNetwork
-            k = stress_strain / rest
-        return Springs(pairs[:, 0].copy(), pairs[:, 1].copy(), rest, k,
-                       np.full(len(pairs), bool(tension_only)))
-
-    @staticmethod
-    def concat(*parts: "Springs") -> "Springs":
-        return Springs(*(np.concatenate([getattr(p, f) for p in parts])
-                         for f in ("i", "j", "rest", "stiffness", "tension_only")))
 
 
 #: settled positions by network digest (oldest dropped first); a few networks' worth
