@@ -27,12 +27,13 @@ from ..params import param
 from .fsm import pose_vector
 
 #: lean back with the legs out (rad), relative to the seated pose (systems/swing.SEATED):
-#: the hips open so the trunk tips back on the seat, the knees straighten, the arms reach up
-#: the chains as the shoulders go back
-#: (leaning further, 0.5 rad at the hips, tips her over backwards off the seat)
-LEAN = (("hip_flex", -0.18), ("knee", -0.6), ("shoulder_flex", 0.18), ("elbow", -0.24))
-#: sit up with the legs tucked under the seat: the trunk forward, the knees bent back
-TUCK = (("hip_flex", 0.09), ("knee", 0.27), ("shoulder_flex", -0.03), ("elbow", 0.06))
+#: the hips open so the trunk tips back on the seat, the knees straighten, the arms straighten
+#: up the chains as the shoulders go back (the trunk ends ~0.95 rad behind the chains); her
+#: hands on the chains at her chest turn her against them
+LEAN = (("hip_flex", -0.18), ("knee", -0.6), ("shoulder_flex", 0.8), ("elbow", -1.0))
+#: sit up with the legs tucked under the seat: the trunk forward, the knees bent back, the
+#: elbows bent as the hands come to the chest
+TUCK = (("hip_flex", 0.09), ("knee", 0.27), ("shoulder_flex", -0.03), ("elbow", 0.3))
 
 
 @dataclass(frozen=True)

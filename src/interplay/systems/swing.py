@@ -51,10 +51,12 @@ class SwingParams:
 
 
 #: her seated pose on the swing (rad): thighs along the seat, shanks hanging, upright; the
-#: hands hold the chains beside her hips, at the seat's height, elbows bent (a child grips
-#: higher, at her chest: docs/swing.md)
+#: hands hold the chains at her chest (0.24 m above the seat: upper arms back along her sides,
+#: elbows bent up), where a child grips them, so that her arms have a lever about the seat
+#: to turn her against the chains (gripping beside her hips, at the seat's height, the same
+#: pumping raised the amplitude 0.29 deg a cycle instead of ~1: docs/swing.md)
 SEATED = (("hip_flex", 1.57), ("knee", 1.57), ("ankle", 0.0), ("waist_flex", 0.0),
-          ("shoulder_flex", -0.4), ("shoulder_abd", 0.18), ("elbow", 0.9))
+          ("shoulder_flex", -0.5), ("shoulder_abd", 0.18), ("elbow", 2.2))
 
 
 def swing_body(spec, p: SwingParams, grips=()):
