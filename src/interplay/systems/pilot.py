@@ -237,7 +237,7 @@ class Pilot(System, RigidParts):
         return self._view
 
     def part_poses(self):
-        return self._poses
+        return self._poses  # made by _pose; callers read it, as they read a body's live state
 
     def part_centres(self):
         return self.part_poses()[0]
