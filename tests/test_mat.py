@@ -50,15 +50,31 @@ def test_mat_under_load_rests_at_the_static_solution():
 
 def test_shipped_stand_in_reproduces_the_mats_load_deflection():
     """The stand-in's curve (the shipped defaults, ``interplay fit-standin mat``) gives the
-    force the default mat measures at its depression, within 10%, over the landing's range
-    (1, 8 and 16 body weights on two feet: the default landing's peak is about 15)."""
+    load the default mat carries under a rigid flat sole pressed to the same depth, within
+    10%, over the landing's range (0.01, 0.05 and 0.1 m: 1.3 to 18.6 body weights; the
+    default landing's peak is about 15)."""
     p = M.MatSceneParams()
-    weight = p.vault.mass * G
-    rows = M.load_deflection(p.mat, [b * weight for b in (1.0, 8.0, 16.0)])
+    rows = M.load_deflection(p.mat, (0.01, 0.05, 0.1))
     model = p.standin.force(rows[:, 1])
     assert np.all(np.abs(model - rows[:, 0]) <= 0.10 * rows[:, 0])
     # and the mat stiffens as foam under a cover does: its secant stiffness rises with load
     assert np.all(np.diff(rows[:, 0] / rows[:, 1]) > 0)
+
+
+@pytest.mark.slow
+def test_shipped_stand_in_reproduces_the_mats_impactor_drops():
+    """The stand-in's damping (fitted by ``fit-standin`` to the mat's impactor drops) with
+    its curve: the 24 kg impactor dropped 0.5, 1 and 2 m on it (a 1-D drop on the stand-in's
+    law, mat_impact.standin_drop) peaks within 10% of the mat's peak force (1 ms mean) and
+    rebounds within 10% of the mat's rebound speed (the issue's tolerance for the stand-in's
+    fit). The mat's drops are 0.25 s each at its 1e-4 s step."""
+    from interplay.scenes.mat_impact import drop_test, standin_drop
+    p = M.MatSceneParams()
+    mat = drop_test(p.mat, (0.5, 1.0, 2.0))
+    stand = standin_drop(p.standin, (0.5, 1.0, 2.0))
+    for m, s in zip(mat, stand):
+        for key in ("peak_mean_force_N", "rebound_m_s"):
+            assert abs(s[key] - m[key]) <= 0.10 * m[key], (key, m, s)
 
 
 def _pass(params, coupling="hybrid", duration=1.0):
@@ -168,8 +184,10 @@ def test_impactor_drop_deforms_the_mat_as_the_impact_tests_did():
     dropped from 1, 2 and 3 m: the depression grows with the drop; energy is bounded both
     ways: the contact's mean force over the depression d must carry the impactor's energy,
     so its peak F >= (m v^2 / 2 + m g d) / d, and the impactor cannot rebound faster than it
-    came (the mat only dissipates); the published band, 0.088-0.118 m "from various
-    heights" (the heights are not in the texts we had), is reached within 2-3 m of drop."""
+    came (the mat only dissipates) nor, with the foam's viscosity (mat.foam_damping),
+    above 0.8 of it (the lattice without it gave back 0.96, a viscoelastic mat much less:
+    docs/mat.md); the published band, 0.088-0.118 m "from various heights" (the heights are
+    not in the texts we had), is reached by 3 m of drop."""
     from interplay.scenes.mat_impact import PUBLISHED, Impactor, drop_test
     rows = drop_test(drops=(1.0, 2.0, 3.0))
     m = Impactor().mass
@@ -178,7 +196,7 @@ def test_impactor_drop_deforms_the_mat_as_the_impact_tests_did():
     for r in rows:
         v, dep = r["impact_speed_m_s"], r["depression_m"]
         assert r["peak_force_N"] >= (0.5 * m * v * v + m * G * dep) / dep
-        assert 0.0 <= r["rebound_m_s"] <= v
+        assert 0.0 <= r["rebound_m_s"] <= 0.8 * v
     assert d[0] < PUBLISHED[0] and PUBLISHED[0] <= d[2] <= PUBLISHED[1]
 
 

@@ -101,6 +101,44 @@ def test_stiffness_proportional_damping_rate():
     assert rate == pytest.approx(beta * k / (2 * m), rel=1e-2)
 
 
+def _two_springs(kd, dt=1e-4, integrator="explicit"):
+    """A free point between two fixed ones along x, the first spring with its own damping
+    kd (N s/m), the second with none; no gravity."""
+    x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    springs = Springs.from_ratio(x, [(0, 1), (1, 2)], 50.0)  # k = 50 N/m each
+    return SpringNetwork("two", x, [1.0, 0.5, 1.0], springs, dt=dt, integrator=integrator,
+                         spring_damping=[kd, 0.0], fixed=[0, 2], gravity=(0, 0, 0))
+
+
+def test_a_springs_own_damping_rate():
+    # one spring of two damped by its own kd (no beta): zeta w = kd / (2 m) on the point
+    # between them (k = 100 N/m in all, m = 0.5 kg), amplitude ~ exp(-kd t / 2m); the
+    # envelope is exact to O(zeta^2) ~ 1e-4 and peak sampling to O(h): 1%, as for beta
+    kd, m = 0.2, 0.5
+    T = 2 * np.pi * np.sqrt(m / 100.0)
+    h = T / 2000
+    net = _two_springs(kd, dt=h)
+    assert net.kd.tolist() == [kd, 0.0]  # beta k (0 here) plus each spring's own
+    net.x[1, 0] += 0.01
+    ts, xs = run(net, 20 * T, h)
+    peaks = [np.max(np.abs(xs[(ts >= a) & (ts < a + T)])) for a in (0.0, 19 * T)]
+    rate = np.log(peaks[0] / peaks[1]) / (19 * T)
+    assert rate == pytest.approx(kd / (2 * m), rel=1e-2)
+
+
+def test_a_springs_own_damping_past_the_explicit_bound_is_refused():
+    # h sum(kd) / m >= 2 takes more than twice a point's velocity away per step: refused,
+    # naming the rate and the largest step; the implicit step takes it; local/global,
+    # whose constant matrix damps with beta alone, refuses springs' own damping
+    with pytest.raises(StabilityError, match=r"damping rate 2e\+03 1/s .* use dt < 0.001 s"):
+        _two_springs(1000.0, dt=1e-3)
+    _two_springs(1000.0, dt=1e-3, integrator="implicit")
+    with pytest.raises(ParameterError, match="own damping need the explicit or implicit"):
+        _two_springs(1.0, integrator="localglobal")
+    with pytest.raises(ParameterError, match="own damping must be finite and >= 0"):
+        _two_springs(-1.0)
+
+
 def elastic_catenary(span, L0, w, EA, s):
     """Irvine's elastic catenary between supports at equal height, by unstretched arc length s.
 

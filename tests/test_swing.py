@@ -55,7 +55,7 @@ def test_with_her_sitting_still_it_swings_at_the_whole_bodys_period():
     """Pumping off, a 0.05 rad push: the period of the compound pendulum of swing and child
     (I and M d summed over every body about the bar at the start, systems/swing.py), within
     1.5%: she is not rigid (her servos at 20 rad/s let her sway on the seat at the swing's
-    2.3 rad/s), which the 0.5% of the chains' caps does not cover; measured 0.3%."""
+    2.3 rad/s), which the 0.5% of the chains' caps does not cover; measured 0.03%."""
     p = replace(S.SwingSceneParams(), pump=PumpParams(enabled=False),
                 swing=replace(SwingParams(), start=0.05))
     fig = S.child(p)
@@ -75,12 +75,11 @@ def test_with_her_sitting_still_it_swings_at_the_whole_bodys_period():
 @pytest.mark.slow
 def test_pumping_raises_the_amplitude_and_sitting_still_lets_it_decay():
     """From a 0.1 rad push over 40 s (14 cycles): pumping raises the amplitude every cycle,
-    by at least 0.15 rad from the second cycle to the last (measured 0.194: 0.114 to 0.308
+    by at least 0.10 rad from the second cycle to the last (measured 0.149: 0.156 to 0.305
     rad, docs/swing.md; with the hands at the seat's height instead of her chest it was 0.060
     over all 14), and by no more a cycle than angular momentum allows (2 (I_c / I_bar) dpsi
-    = 0.027 rad with her 1.05 rad between the poses; measured
-    0.018 at most, docs/swing.md); sitting still, drag and
-    the bearings take it down every cycle (0.067 to 0.065 rad)."""
+    = 0.033 rad with her 1.2 rad between the poses; measured 0.015 at most, docs/swing.md);
+    sitting still, drag and the bearings take it down every cycle (0.105 to 0.101 rad)."""
     out = {}
     for on in (True, False):
         fig = S.child(replace(S.SwingSceneParams(), pump=PumpParams(enabled=on)))
@@ -91,8 +90,8 @@ def test_pumping_raises_the_amplitude_and_sitting_still_lets_it_decay():
             a.append(fig.swing_angle())
         out[on] = S.amplitudes(np.array(t), np.array(a))[1]
     up, down = out[True], out[False]
-    assert np.all(np.diff(up) > 0) and up[-1] - up[1] >= 0.15, up
-    assert np.all(np.diff(up[1:]) < 0.028), up
+    assert np.all(np.diff(up) > 0) and up[-1] - up[1] >= 0.10, up
+    assert np.all(np.diff(up[1:]) < 0.033), up
     assert np.all(np.diff(down) < 0), down
 
 
@@ -109,6 +108,23 @@ def test_the_skirt_is_certified_every_frame_and_the_advisor_says_one_way():
     assert {"cloth_body_intersections", "penetration_m", "self_intersections",
             "stretch"} <= set(cert["per_frame"][0])
     assert res.advice_for(res.interaction("skirt-body"))["mode"] == "one-way"
+    # the skirt she sits on stays on the seat: at every frame no point of it over the board is
+    # inside it deeper than the contact's 5 mm skin, nor under it (it hung through the board
+    # before the seat was a collider: 8-11 points inside, up to 9.8 mm, and 10-16 under)
+    sw, inside, under = SwingParams(), 0.0, 0
+    child, skirt = res.frames["child"], res.frames["skirt"]
+    for pos, q, x in zip(child["segment_positions"][:, -1], child["segment_orientations"][:, -1],
+                         skirt["points"]):
+        c, y = q[0], q[2]  # the swing turns about y only: q = (cos, 0, sin, 0) of half a turn
+        R = np.array([[1 - 2 * y * y, 0, 2 * c * y], [0, 1, 0], [-2 * c * y, 0, 1 - 2 * y * y]])
+        local = (x - pos) @ R
+        over = ((np.abs(local[:, 0]) < 0.5 * sw.depth - 0.005)
+                & (np.abs(local[:, 1]) < 0.5 * sw.width - 0.005))
+        depth = -sw.chain - local[over, 2]  # below the board's top (m)
+        d = depth[(depth > 0) & (depth < sw.thickness)]
+        inside = max(inside, float(np.minimum(d, sw.thickness - d).max()) if len(d) else 0.0)
+        under = max(under, int(np.sum(depth >= sw.thickness)))
+    assert inside <= 0.005 and under == 0, (inside, under)
 
 
 @pytest.mark.parametrize("swing, match", [

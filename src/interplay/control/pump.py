@@ -33,7 +33,7 @@ from .fsm import pose_vector
 LEAN = (("hip_flex", -0.18), ("knee", -0.6), ("shoulder_flex", 0.8), ("elbow", -1.0))
 #: sit up with the legs tucked under the seat: the trunk forward, the knees bent back, the
 #: elbows bent as the hands come to the chest
-TUCK = (("hip_flex", 0.09), ("knee", 0.27), ("shoulder_flex", -0.03), ("elbow", 0.3))
+TUCK = (("hip_flex", 0.09), ("knee", 0.27), ("shoulder_flex", -0.03), ("elbow", 0.15))
 
 
 @dataclass(frozen=True)

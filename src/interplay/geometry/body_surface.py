@@ -400,9 +400,12 @@ class BodySurface:
 
     # --- posing ----------------------------------------------------------------------------------
     def transforms(self, seg_pos, seg_rot):
-        """Per segment, (A (17,3,3), b (17,3)): x = A x0 + b carries A-pose points with it."""
-        A = np.einsum("kij,klj->kil", np.asarray(seg_rot, float), self.rot0)
-        b = np.asarray(seg_pos, float) - np.einsum("kij,kj->ki", A, self.pos0)
+        """Per segment, (A (17,3,3), b (17,3)): x = A x0 + b carries A-pose points with it.
+        Poses of parts after her 17 segments (a swing a figure shows to contacts) are not hers:
+        they are ignored."""
+        k = len(self.rot0)
+        A = np.einsum("kij,klj->kil", np.asarray(seg_rot, float)[:k], self.rot0)
+        b = np.asarray(seg_pos, float)[:k] - np.einsum("kij,kj->ki", A, self.pos0)
         return A, b
 
     def pose(self, seg_pos, seg_rot, points=None) -> np.ndarray:

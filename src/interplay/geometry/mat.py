@@ -8,14 +8,17 @@ block resists being crushed in any direction, not only along its edges). Edge sp
 k = E a / n, with E the foam's compressive modulus (Pa), a the area a spring carries (the cell's
 face shared among the four edges around it) and n its rest length, so the block's
 stiffness does not depend on the resolution; the braces are a share ``brace`` of that.
-Stiffness-proportional damping (beta, s) is the foam's viscosity: landing mats are
-viscoelastic and absorb most of an impact rather than return it (Mills, Pain & Yeadon 2006).
+The foam is viscoelastic (Kelvin-Voigt: each foam spring's force k (l - l0) + tau k dl/dt,
+tau the foam's retardation time): landing mats absorb most of an impact rather than return it
+(Mills, Pain & Yeadon 2006). Only the foam's share of a spring is damped so: the stiff top
+cover (vinyl, firm foam) would set the explicit step's damping bound at a hundredth of the
+foam's (docs/mat.md), so it keeps the network's small stiffness-proportional beta alone.
 
 Calibration (docs/mat.md): Pain, Mills & Yeadon (2005, Med. Sci. Sports Exerc. 37) dropped a
 24 kg impactor on a competition landing mat and measured 0.088-0.118 m of deformation; the
-modulus below puts this lattice's deformation under that impactor in the band
-(``impactor_drop``), and its measured load-deflection under two feet is what the hybrid
-stand-in is fitted to (``load_deflection``).
+modulus below puts this lattice's deformation under that impactor in the band by a 3 m drop
+(scenes/mat_impact.drop_test), and its measured load-deflection under a rigid sole and its
+impactor drops are what the hybrid stand-in is fitted to (scenes/mat.fit).
 """
 from __future__ import annotations
 
@@ -36,8 +39,10 @@ class MatParams:
     comparison); length, width, thickness (m) along x, y, z; nx, ny, nz: lattice points along
     each (nz layers); mass (kg): foam and cover; modulus (Pa): the foam's compressive modulus
     E (edge springs k = E a / l); brace (-): the diagonals' stiffness as a share of an
-    edge's; stiffness_damping (s): beta of the springs' Rayleigh damping (the foam's
-    viscosity); mass_damping (1/s); dt (s): the lattice's explicit step; thickness of the
+    edge's; foam_damping, brace_damping (s): the foam's retardation time tau on its edges
+    (its compression) and on its braces (shear, volume): kd = tau k of the foam's share of a
+    spring; stiffness_damping (s): beta of every spring's Rayleigh damping, the cover's too;
+    mass_damping (1/s); dt (s): the lattice's explicit step; thickness of the
     contact skin on its top (m) is the contact's; x0 (m): the mat's near edge along x (the
     direction of the vault)."""
     enabled: bool = param(True, doc="false: a rigid floor at the mat's top instead")
@@ -52,7 +57,9 @@ class MatParams:
     brace: float = param(1.5, "-", ge=0.0, le=10.0, doc="diagonals' share of an edge's k")
     cover: float = param(2.0e4, "N", ge=0.0, le=1e8, doc="the top cover's stress/strain")
     top_ratio: float = param(1.0, "-", gt=0.0, le=1e3, doc="top layer's modulus / the foam's")
-    stiffness_damping: float = param(1e-4, "s", ge=0.0, le=1.0)
+    foam_damping: float = param(5.5e-3, "s", ge=0.0, le=1.0, doc="foam edges' tau (viscosity)")
+    brace_damping: float = param(0.0, "s", ge=0.0, le=1.0, doc="foam braces' tau")
+    stiffness_damping: float = param(0.0, "s", ge=0.0, le=1.0)
     mass_damping: float = param(20.0, "1/s", ge=0.0, le=1e3)
     dt: float = param(1e-4, "s", gt=0.0, le=0.01)
     x0: float = param(1.5, "m", ge=-100.0, le=100.0, doc="near edge along x")
@@ -79,7 +86,8 @@ class MatParams:
 
 @dataclass(frozen=True)
 class Lattice:
-    """The built mat: positions (n,3) m, masses (n,) kg, springs (i, j, rest m, k N/m);
+    """The built mat: positions (n,3) m, masses (n,) kg, springs (i, j, rest m, k N/m, kd
+    N s/m: the foam's own damping);
     kind (s,) 0 edge, 1 face diagonal, 2 body diagonal; bottom, top: indices of the bottom
     and top layers; triangles (t,3): the block's outer surface (drawn); top_edges (e,2): the
     top face's edges and both diagonals of each of its cells (what a foot collides with:
@@ -90,6 +98,7 @@ class Lattice:
     j: np.ndarray
     rest: np.ndarray
     k: np.ndarray
+    kd: np.ndarray
     kind: np.ndarray
     bottom: np.ndarray
     top: np.ndarray
@@ -190,6 +199,8 @@ def build_mat(p: MatParams) -> Lattice:
     # on every spring lying in the top face (its edges and face diagonals)
     zi, zj = x[ij[:, 0], 2], x[ij[:, 1], 2]
     skin = (np.abs(zi - p.thickness) < 1e-9) & (np.abs(zj - p.thickness) < 1e-9)
+    # the foam's viscosity on its share of each spring (the cover's share is not foam)
+    kd = np.where(edge, p.foam_damping, p.brace_damping) * k
     k[skin] += p.cover / rest[skin]
     bottom = idx[:, :, 0].ravel()
     top = idx[:, :, -1].ravel()
@@ -205,5 +216,5 @@ def build_mat(p: MatParams) -> Lattice:
                         np.stack([t[:-1, :-1].ravel(), t[1:, 1:].ravel()], 1),
                         np.stack([t[1:, :-1].ravel(), t[:-1, 1:].ravel()], 1)])
     e = np.sort(e, axis=1)
-    return Lattice(x, masses, ij[:, 0].copy(), ij[:, 1].copy(), rest, k, kind, bottom, top,
+    return Lattice(x, masses, ij[:, 0].copy(), ij[:, 1].copy(), rest, k, kd, kind, bottom, top,
                    tris, np.unique(e, axis=0), (nx, ny, nz))

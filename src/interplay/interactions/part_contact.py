@@ -86,10 +86,11 @@ class PartContact(Interaction):
     ((p, p) for points); default the edges of its triangles, else its springs. extra:
     ((part name, Primitive), ...) more primitives that parts have for this contact beside their
     own (a figure's neck, which its sphere of a head leaves out, for a noose round it); each
-    pushes on its part."""
+    pushes on its part. parts: the names of the parts whose own primitives collide (default
+    all; a swing's seat alone, where another contact keeps the cloth off her body)."""
 
     def __init__(self, name, bodies, network, params: PartContactParams = PartContactParams(),
-                 mode="two-way", standin=None, elements=None, extra=()):
+                 mode="two-way", standin=None, elements=None, extra=(), parts=None):
         super().__init__(name, bodies, network, mode, standin)
         self.p = params.validated(name)
         view, net = bodies.contact_view(), network.contact_view()
@@ -99,14 +100,16 @@ class PartContact(Interaction):
         if net is None or net.kind != "points":
             raise SceneError(f"interaction {name}: {network.name} is not a spring-mass "
                              "network; use MeshContact for other surfaces")
-        unknown = [nm for nm, _ in extra if nm not in view.names]
+        own = list(view.names) if parts is None else list(parts)
+        unknown = [nm for nm in own + [nm for nm, _ in extra] if nm not in view.names]
         if unknown:
             raise SceneError(f"interaction {name}: {bodies.name} has no parts "
-                             f"{', '.join(unknown)} for the extra primitives")
+                             f"{', '.join(unknown)}; its parts are {', '.join(view.names)}")
         # one row of the kernels' bundle per primitive: the parts' own, then the extra ones
-        self.owner = np.r_[np.arange(view.count), [view.names.index(nm) for nm, _ in extra]]
-        self.owner = self.owner.astype(np.int64)
-        self.primitives = list(view.primitives) + [pr for _, pr in extra]
+        self.owner = np.array([view.names.index(nm) for nm in own]
+                              + [view.names.index(nm) for nm, _ in extra], dtype=np.int64)
+        self.primitives = ([view.primitives[view.names.index(nm)] for nm in own]
+                           + [pr for _, pr in extra])
         missing = [view.names[o] for o, pr in zip(self.owner, self.primitives) if pr is None
                    or pr.kind not in PC.KINDS]
         if missing:

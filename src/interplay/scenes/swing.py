@@ -22,7 +22,9 @@ from ..control.fsm import Controller, State
 from ..control.pump import Pump, PumpParams
 from ..geometry.anthropometry import BodyParams
 from ..geometry.body_surface import SurfaceParams, figure_surface
+from ..geometry.anthropometry import SEGMENTS
 from ..geometry.garment import Fit, skirt
+from ..interactions.part_contact import PartContact, PartContactParams
 from ..interactions.skin_contact import PosedSkin, SkinContact, SkinContactParams
 from ..geometry.setpieces import merge, rod
 from ..outputs.render.camera import TrackingCamera
@@ -33,7 +35,7 @@ from ..systems.figure import FigureParams
 from ..systems.figure_model import EnvironmentParams
 from ..systems.garments import dress, network
 from ..systems.static import StaticPlane
-from ..systems.swing import SEATED, SwingFigure, SwingParams
+from ..systems.swing import SEATED, SwingFigure, SwingParams, seat_primitive
 from .contract import SceneSpec
 
 ARM_OMEGA = 20.0  # rad/s: her arms hold her on the seat through the grips (softer: she tips)
@@ -52,13 +54,16 @@ class SkirtParams:
     """enabled: she wears it; skin: her body surface; fit: how it is cut (a loose A-line:
     sitting, the skirt must span from her waist over her thighs, so its ease is 5 cm: at
     1-3 cm the fabric is caught in the fold of her hip, 300 crossings of her skin after
-    dressing, against 18 at 5 cm); contact: cloth on skin; cloth_dt (s): the cloth's step,
+    dressing, against 18 at 5 cm); contact: cloth on skin; seat: cloth on the swing's seat
+    (the rigid-parts contact, the skin's gap and friction; its edges rounded by 5 mm, a
+    rubber belt seat's); cloth_dt (s): the cloth's step,
     the coupling step; dress_s (s): dressing by moving her from the A-pose it was cut in to
     the seated pose; settle_s (s): then settling, before t = 0."""
     enabled: bool = param(True, doc="false: no skirt")
     skin: SurfaceParams = SurfaceParams(spacing=0.02)
     fit: Fit = Fit(spacing=0.02, length=0.6, ease=0.05)
     contact: SkinContactParams = SkinContactParams(tether=0.0)
+    seat: PartContactParams = PartContactParams(thickness=0.005, friction=0.5, rounding=0.005)
     cloth_dt: float = param(1.0 / 240.0, "s", ge=1e-4, le=0.02)
     dress_s: float = param(1.0, "s", ge=0.0, le=10.0)
     settle_s: float = param(0.4, "s", ge=0.0, le=10.0)
@@ -83,16 +88,22 @@ def dressed_skirt(fig: SwingFigure, p: SkirtParams, h: float):
     """(her surface, the skirt's network dressed on her seated pose, the dressing report).
     Cutting and dressing (~15 s) are done once per process for the same parameters and pose;
     a rebuild restores the dressed state."""
-    pos, R = fig.part_poses()
+    pos, R = (a[:len(SEGMENTS)] for a in fig.part_poses())  # hers, not the swing's
     key = (repr(p), h, pos.round(6).tobytes())
     if key not in _DRESSED:
         surface = figure_surface(fig, p.skin)
         garment = skirt(surface, p.fit)
         net = _network(garment, h)
         # little friction while dressing, so the fabric slides into place (the runner's)
+        # the seat joins for the settling: while she is moved into her seated pose the
+        # skirt's back hangs through where the seat is; at rest a pedestal under the board
+        # pushes it the short way out, up onto the seat or back past its edge
+        seat = PartContact("skirt-seat", fig, net, p.seat, mode="one-way", parts=(),
+                           extra=(("swing", seat_primitive(fig.swing, below=0.3)),))
         report = dress(net, surface, pos, R, p.dress_s, p.settle_s, h,
                        replace(p.contact, friction=0.05),
-                       skin_velocity=PosedSkin(fig, surface).now()[1], tether=p.contact.tether)
+                       skin_velocity=PosedSkin(fig, surface).now()[1], tether=p.contact.tether,
+                       settle_with=(seat,))
         _DRESSED.clear()
         _DRESSED[key] = (surface, garment, net.x.copy(), net.v.copy(), report)
     surface, garment, x, v, report = _DRESSED[key]
@@ -145,6 +156,8 @@ def build(coupling: str = "one-way", duration: float = 12.0, fps: float = 30.0,
         scene.add(net)
         scene.connect(SkinContact("skirt-body", fig, net, surface, params.skirt.contact,
                                   mode=coupling))
+        scene.connect(PartContact("skirt-seat", fig, net, params.skirt.seat, mode=coupling,
+                                  parts=("swing",)))
         net.watch(PosedSkin(fig, surface))
         g = net.garment
         meta = {"skirt": {"mass_kg": g.mass, "fabric": g.fabric.name, "sizes": g.sizes,

@@ -100,10 +100,12 @@ def bed(p: BedParams, integrator: str = "explicit", dt: float | None = None) -> 
 EXPLICIT_SHARE = 2.5
 
 
-def check_explicit(net: SpringNetwork, key: str = "bed.dt"):
+def check_explicit(net: SpringNetwork, key: str = "bed.dt",
+                   cure: str = "less stretch or stiffness_damping"):
     """Refuse an explicit step at which the bed's stiffest point is unstable: symplectic Euler
     with damping, x'' + c x' + w^2 x = 0, is stable for h c < 2 and h^2 w^2 + 2 h c < 4, here
-    with w^2 = sum k / m and c = beta sum k / m + alpha, the highest in-plane mode of a grid
+    with w^2 = sum k / m and c = sum kd / m + alpha (net.damping_rates: beta sum k / m + alpha
+    when the springs have no damping of their own), the highest in-plane mode of a grid
     point (its neighbours along one axis moving against it, the springs across it carrying
     tension only); the contact needs the margin EXPLICIT_SHARE leaves."""
     k = np.zeros(len(net.x))
@@ -111,7 +113,7 @@ def check_explicit(net: SpringNetwork, key: str = "bed.dt"):
     np.add.at(k, net.sj, net.k)
     free = ~net.fixed
     w2 = k[free] / net.m[free]
-    c = net.beta * w2 + net.alpha
+    c = net.damping_rates()[free]
     h = net.dt
     worst = float(np.max(h * h * w2 + 2.0 * h * c))
     if worst > EXPLICIT_SHARE:
@@ -120,7 +122,7 @@ def check_explicit(net: SpringNetwork, key: str = "bed.dt"):
         raise StabilityError(
             f"{net.name}: dt={h:.3g} s is too large for its stiffness and damping (explicit "
             f"stability number {worst:.2f}, at most {EXPLICIT_SHARE}); use {key} <= "
-            f"{bound:.2g} s, or less stretch or stiffness_damping")
+            f"{bound:.2g} s, or {cure}")
 
 
 def pressed_points(net: SpringNetwork, half: float = 0.15) -> np.ndarray:

@@ -175,9 +175,21 @@ class Figure(System, RigidParts):
         self._twist = np.zeros(6)
         self.color = None
         self._platform = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "platform")
+        # the contact view's parts: her segments (a subclass may add bodies of its model
+        # that contacts should see, e.g. a swing's seat: ``add_part``)
+        self.part_body = self.seg_body.copy()
         self._view = BodiesView(self, SEGMENTS, self.segment_meshes(),
                                 [segment_primitive(s.shape) for s in self.plan],
                                 m.body_mass[self.seg_body], movable=True)
+
+    def add_part(self, name: str, body: int, mesh, primitive) -> None:
+        """Show another body of her MuJoCo model to contacts as a part after her segments:
+        ``mesh`` (vertices (n,3) m, triangles) and ``primitive`` in the body's frame."""
+        v = self._view
+        self.part_body = np.r_[self.part_body, int(body)]
+        self._view = BodiesView(self, v.names + [name], v.meshes + [mesh],
+                                list(v.primitives) + [primitive],
+                                self.model.body_mass[self.part_body], movable=True)
 
     # --- servos and control ------------------------------------------------------------------
     def apply_gains(self):
@@ -350,13 +362,16 @@ class Figure(System, RigidParts):
         self.touched[:] = False
 
     def mark_touching(self, parts):
-        """Segments another system's contact touches this step (cleared with the forces)."""
-        self.touched[np.asarray(parts, dtype=np.int64)] = True
+        """Segments another system's contact touches this step (cleared with the forces);
+        parts added by ``add_part`` are not hers to sense."""
+        parts = np.asarray(parts, dtype=np.int64)
+        self.touched[parts[parts < len(self.touched)]] = True
 
     def add_wrench(self, force, torque=None, point=None, body=0):
         """Add a force (N) at a world point (m; default the segment's centre of mass) and a
-        torque (N m) to a segment, named or by index in SEGMENTS (default the pelvis)."""
-        b = self.seg_body[SEGMENTS.index(body) if isinstance(body, str) else int(body)]
+        torque (N m) to a segment, named or by index in SEGMENTS (default the pelvis), or to a
+        part added by ``add_part`` by its index in the contact view."""
+        b = self.part_body[SEGMENTS.index(body) if isinstance(body, str) else int(body)]
         f = np.asarray(force, dtype=float)
         w = self.data.xfrc_applied[b]
         w[:3] += f
@@ -530,15 +545,15 @@ class Figure(System, RigidParts):
 
     def part_poses(self):
         d = self.data
-        return d.xpos[self.seg_body], d.xmat[self.seg_body].reshape(-1, 3, 3)
+        return d.xpos[self.part_body], d.xmat[self.part_body].reshape(-1, 3, 3)
 
     def part_centres(self):
-        return self.data.xipos[self.seg_body]
+        return self.data.xipos[self.part_body]
 
     def part_velocities(self, parts=None):
         """MuJoCo's velocities of the segments' centres of mass, world frame (one call per
         segment asked for)."""
-        bodies = self.seg_body if parts is None else self.seg_body[np.asarray(parts)]
+        bodies = self.part_body if parts is None else self.part_body[np.asarray(parts)]
         lin, ang = np.empty((len(bodies), 3)), np.empty((len(bodies), 3))
         for k, b in enumerate(bodies):
             self._mj.mj_objectVelocity(self.model, self.data, self._mj.mjtObj.mjOBJ_BODY,
@@ -549,7 +564,7 @@ class Figure(System, RigidParts):
     def part_inverse_inertias(self):
         """Zero: a contact sees a segment's own mass only; its joints make the real effective
         mass larger, so the contact is a little softer than it could be, never less stable."""
-        return np.zeros((len(self.seg_body), 3, 3))
+        return np.zeros((len(self.part_body), 3, 3))
 
     def centre_of_mass(self):
         return self.com()

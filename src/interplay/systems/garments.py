@@ -203,7 +203,8 @@ def _slerp(R0, R1, f):
 
 def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
           settle: float = 0.4, h: float | None = None, contact=None, self_contact=None,
-          skin_velocity=None, damping: float = 4.0, tether: float = 0.0) -> dict:
+          skin_velocity=None, damping: float = 4.0, tether: float = 0.0,
+          settle_with=()) -> dict:
     """Dress the network (cut in the surface's A-pose) on the body posed at (seg_pos (17,3),
     seg_rot (17,3,3)): ``seconds`` of the skin moving there from the A-pose (rotations by
     slerp, positions linearly, eased in and out; 0: the garment carried there by the skin's
@@ -211,8 +212,10 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
     damping ``damping`` (1/s) on top of the cloth's own; contact: a SkinContactParams;
     self_contact: an interaction (SelfContact) exchanged every step; skin_velocity (nb,3)
     m/s: the skin's velocity at the target pose, given to the cloth at the end; tether (m): the
-    points kept within it of their skinned reference (``Garments.tether``). Returns what
-    it measured at the end (intersections, penetration, steps)."""
+    points kept within it of their skinned reference (``Garments.tether``); settle_with:
+    interactions on the garment exchanged in the settling steps only (colliders the garment
+    is moved through while the body moves, e.g. the seat she sits down on). Returns what it
+    measured at the end (intersections, penetration, steps)."""
     from ..interactions.skin_contact import SkinContactParams, _Projector
     h = net.dt if h is None else h
     contact = SkinContactParams() if contact is None else contact
@@ -242,6 +245,8 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
     prev = surface.pose(pos0, rot0)
     net.ride(surface, pos0, rot0, h)
     net.v[net.pinned] = 0.0
+    for it in settle_with:
+        it.prepare(h)
     try:
         for k in range(1, steps_move + steps_settle + 1):
             f = min(1.0, k / steps_move)
@@ -253,6 +258,9 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
             net.clear_forces()
             if self_contact is not None:
                 self_contact.exchange(False, True)
+            if k > steps_move:
+                for it in settle_with:
+                    it.exchange(False, True)
             net.ride(surface, P, R, h)
             proj.start()
             net.advance(h)

@@ -1,8 +1,10 @@
 """Spring-mass networks: nets, cords, cloth (SPEC 2.1).
 
 Point masses joined by linear springs, with Rayleigh damping (mass-proportional -alpha m v and
-stiffness-proportional along each spring, kd = beta k), optional tension-only cords, points
-fixed in place (constraint filter) and points tied to world positions by anchor springs.
+stiffness-proportional along each spring, kd = beta k) plus any spring's own viscosity (a
+group of springs damped beyond beta: a foam's, not its stiff cover's), optional tension-only
+cords, points fixed in place (constraint filter) and points tied to world positions by anchor
+springs.
 Three integrators: ``explicit`` (symplectic Euler, the reference), ``implicit`` (backward
 Euler, one Newton step, preconditioned CG; Baraff & Witkin 1998) and ``localglobal`` (Liu et
 al. 2013: a prefactored constant matrix and per-spring projections; ``kernels/localglobal.py``).
@@ -11,8 +13,6 @@ from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
@@ -27,6 +27,7 @@ from ..kernels.part_contact import Parts
 from ..kernels.subcycle import advance_with_colliders, advance_with_parts
 from .base import GRAVITY, System, substeps
 from .shape import Shape, split_color
+from .spring_set import Springs  # noqa: F401 (networks are built from it: springmass.Springs)
 from .views import PointsView
 
 INTEGRATORS = ("explicit", "implicit", "localglobal")
@@ -36,41 +37,6 @@ LG_SOLVERS = ("auto", "direct", "multigrid")
 # 0.16 ms against 0.37 ms for the factored solve, at 32^2 they are even, and the factor's cost
 # grows as n^1.25)
 MULTIGRID_MIN_POINTS = 4000
-
-
-@dataclass(frozen=True)
-class Springs:
-    """A set of springs between points i and j.
-
-    rest: rest length (m); stiffness: N/m; tension_only: cords that go slack when compressed.
-    A negative rest length is a preloaded extension spring (a coil spring wound with initial
-    tension, as a trampoline's): it pulls k (l - rest) at every length l, k |rest| even at
-    zero length, so it is never slack; only springs that are not tension-only may have one,
-    and the strain measure leaves them out.
-    """
-    i: np.ndarray
-    j: np.ndarray
-    rest: np.ndarray
-    stiffness: np.ndarray
-    tension_only: np.ndarray
-
-    @staticmethod
-    def from_ratio(x, pairs, stress_strain: float, tension_only: bool = False) -> "Springs":
-        """Springs on index pairs at their current lengths, k = (stress/strain ratio) / l0.
-
-        stress_strain: force per unit strain (N), e.g. E*A for a cord; independent of resolution.
-        """
-        pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
-        rest = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
-        with np.errstate(divide="ignore"):  # zero lengths are reported by SpringNetwork
-            k = stress_strain / rest
-        return Springs(pairs[:, 0].copy(), pairs[:, 1].copy(), rest, k,
-                       np.full(len(pairs), bool(tension_only)))
-
-    @staticmethod
-    def concat(*parts: "Springs") -> "Springs":
-        return Springs(*(np.concatenate([getattr(p, f) for p in parts])
-                         for f in ("i", "j", "rest", "stiffness", "tension_only")))
 
 
 #: settled positions by network digest (oldest dropped first); a few networks' worth
@@ -101,6 +67,8 @@ class SpringNetwork(System):
 
     positions: (n,3) m; masses: (n,) kg; springs: a ``Springs`` set;
     mass_damping: alpha (1/s), force -alpha m_i v_i; stiffness_damping: beta (s), kd = beta k;
+    spring_damping: (s,) N s/m, each spring's own along-spring damping added to beta k (a group
+    of springs viscous beyond what beta allows the stiffest; explicit or implicit only);
     anchors: (indices, world positions (a,3) m, stiffness N/m, damping N s/m) zero-length springs;
     fixed: indices of points that never move; strain_limit: a strain above which the state is
     reported unstable; scheme: the implicit integrator, "bdf2" (second order, little numerical
@@ -123,7 +91,8 @@ class SpringNetwork(System):
     """
 
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
-                 mass_damping=0.0, stiffness_damping=0.0, anchors=None, fixed=(),
+                 mass_damping=0.0, stiffness_damping=0.0, spring_damping=None, anchors=None,
+                 fixed=(),
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
                  scheme="theta", theta=1.0, lg_iterations=10, lg_memory=3,
                  lg_tolerance=1e-4, lg_solver="auto", parallel=False, triangles=None,
@@ -152,7 +121,7 @@ class SpringNetwork(System):
         self.tension_only = springs.tension_only.astype(np.bool_)
         self.alpha = require_nonnegative(name, "mass_damping", mass_damping, "1/s")
         self.beta = require_nonnegative(name, "stiffness_damping", stiffness_damping, "s")
-        self.kd = self.beta * self.k
+        self.kd = self.beta * self.k + self._own_damping(spring_damping, integrator)
         if anchors is None:
             anchors = (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0))
         idx, pos, ak, ac = anchors
@@ -271,7 +240,32 @@ class SpringNetwork(System):
             raise ParameterError(f"spring {bad[0]} has non-positive stiffness {s.stiffness[bad[0]]}"
                                  " N/m: stiffness must be > 0")
 
+    def _own_damping(self, kd, integrator) -> np.ndarray:
+        """The springs' own damping (N s/m), checked: one finite value >= 0 per spring; the
+        local/global step damps with beta alone (its constant matrix), so it refuses them."""
+        if kd is None:
+            return np.zeros(len(self.k))
+        kd = np.broadcast_to(np.asarray(kd, dtype=float), self.k.shape).copy()
+        if not np.all(np.isfinite(kd) & (kd >= 0.0)):
+            bad = int(np.argmin(np.isfinite(kd) & (kd >= 0.0)))
+            raise ParameterError(f"{self.name}: spring {bad}'s own damping must be finite and "
+                                 f">= 0 N s/m, got {kd[bad]}")
+        if integrator == "localglobal" and np.any(kd > 0.0):
+            raise ParameterError(f"{self.name}: springs with their own damping need the "
+                                 "explicit or implicit integrator (local/global damps with "
+                                 "stiffness_damping alone)")
+        return kd
+
     # --- stability -------------------------------------------------------------------------
+    def damping_rates(self) -> np.ndarray:
+        """(n,) 1/s: each point's damping rate, sum of its springs' kd over its mass plus
+        alpha: an explicit step h must keep h times it under 2 (a step that takes away more
+        than twice a point's velocity relative to its neighbours reverses and grows it)."""
+        c = np.zeros(len(self.x))
+        np.add.at(c, self.si, self.kd)
+        np.add.at(c, self.sj, self.kd)
+        return c / self.m + self.alpha
+
     def stable_step(self) -> float:
         """Explicit (symplectic Euler) bound, dt < min_i sqrt(2 m_i / sum_j k_ij)  (s)."""
         ksum = np.zeros(len(self.x))
@@ -291,6 +285,16 @@ class SpringNetwork(System):
                 raise StabilityError(
                     f"{self.name}: dt={dt:.3g} s is above the explicit stability bound "
                     f"{bound:.3g} s; use dt < {bound:.3g} or --integrator implicit")
+            # the springs' own damping can pass this bound where beta k could not (a scene's
+            # own check, as the trampoline's check_explicit, names its keys for beta)
+            own = bool(np.any(self.kd > self.beta * self.k))
+            c = self.damping_rates()[~self.fixed]
+            if own and len(c) and dt * c.max() >= 2.0:
+                raise StabilityError(
+                    f"{self.name}: dt={dt:.3g} s times the largest damping rate "
+                    f"{c.max():.3g} 1/s (sum of kd / m + alpha) is {dt * c.max():.2f}, at "
+                    f"least 2: unstable; use dt < {2.0 / c.max():.3g} s, less damping or "
+                    "--integrator implicit")
 
     # --- forces ----------------------------------------------------------------------------
     @property

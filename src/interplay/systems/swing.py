@@ -22,6 +22,7 @@ import numpy as np
 from ..control.fsm import pose_vector
 from ..errors import ParameterError, require_positive
 from ..geometry.anthropometry import SEGMENTS
+from ..geometry.primitive import Primitive
 from ..geometry.setpieces import box, merge, rod
 from ..params import param
 from .figure import Figure, FigureParams
@@ -38,7 +39,10 @@ class SwingParams:
     residential and playground set); chain_mass (kg) each (galvanized 4/0 swing chain,
     ~0.4 kg/m); seat_mass (kg; a rubber belt seat, 1-2 kg); width (m) between the chains;
     depth, thickness (m) of the seat; damping (N m s/rad) of the bar's bearings; start (rad):
-    the swing's angle at t = 0 (positive: forward, the way she faces)."""
+    the swing's angle at t = 0 (positive: forward, the way she faces); sit_gap (m): how far
+    above the seat her thighs rest (the seat's MuJoCo contact margin): the room the fabric she
+    sits on takes, kept by the cloth's contacts with her skin and with the seat (5 mm each,
+    scenes/swing.py), so a skirt under her is not pinched between them."""
     bar: float = param(2.5, "m", gt=0.0, le=20.0)
     chain: float = param(2.0, "m", gt=0.0, le=19.0)
     chain_mass: float = param(0.8, "kg", gt=0.0, le=100.0)
@@ -48,6 +52,7 @@ class SwingParams:
     thickness: float = param(0.02, "m", gt=0.002, le=0.2)
     damping: float = param(0.05, "N m s/rad", ge=0.0, le=100.0)
     start: float = param(0.1, "rad", ge=-1.2, le=1.2)
+    sit_gap: float = param(0.012, "m", ge=0.0, le=0.05)
 
 
 #: her seated pose on the swing (rad): thighs along the seat, shanks hanging, upright; the
@@ -56,7 +61,7 @@ class SwingParams:
 #: to turn her against the chains (gripping beside her hips, at the seat's height, the same
 #: pumping raised the amplitude 0.29 deg a cycle instead of ~1: docs/swing.md)
 SEATED = (("hip_flex", 1.57), ("knee", 1.57), ("ankle", 0.0), ("waist_flex", 0.0),
-          ("shoulder_flex", -0.5), ("shoulder_abd", 0.18), ("elbow", 2.2))
+          ("shoulder_flex", -1.0), ("shoulder_abd", 0.18), ("elbow", 2.4))
 
 
 def swing_body(spec, p: SwingParams, grips=()):
@@ -83,7 +88,8 @@ def swing_body(spec, p: SwingParams, grips=()):
     body.add_geom(name="seat", type=mujoco.mjtGeom.mjGEOM_BOX,
                   size=[0.5 * p.depth, w, 0.5 * p.thickness],
                   pos=[0.0, 0.0, -p.chain - 0.5 * p.thickness], mass=p.seat_mass,
-                  contype=WORLD_GROUP, conaffinity=FIGURE_GROUP, friction=[1.0, 0.005, 1e-4])
+                  contype=WORLD_GROUP, conaffinity=FIGURE_GROUP, friction=[1.0, 0.005, 1e-4],
+                  margin=p.sit_gap)
     for k, g in enumerate(grips):
         body.add_site(name=f"grip_{k}", pos=np.asarray(g, float) - top)
     return body
@@ -116,6 +122,8 @@ class SwingFigure(Figure):
         self._sq, self._sv = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
         self.swing_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "swing")
         self.swing_mass = float(m.body_mass[self.swing_body])
+        # contacts see the swing as one more part, its seat a box (the skirt on the seat)
+        self.add_part("swing", self.swing_body, swing_mesh(swing), seat_primitive(swing))
         self._pose(swing.start)
 
     def _pose(self, angle: float):
@@ -186,6 +194,16 @@ def swing_mesh(p: SwingParams):
                      [0.5 * p.depth, w + 0.01, -p.chain]))
 
 
+def seat_primitive(p: SwingParams, below: float = 0.0) -> Primitive:
+    """The seat as a box in the swing's body frame (origin on the bar), m; below (m): the box
+    reaching that much further down (a pedestal under the board: what is inside it is nearer
+    the top or a side than the bottom, so a contact pushes it up onto the seat or out past
+    its edge, never down through it)."""
+    h = p.thickness + below
+    return Primitive("box", axes=(0.5 * p.depth, 0.5 * p.width, 0.5 * h),
+                     centre=(0.0, 0.0, -p.chain - 0.5 * h))
+
+
 def _palm(plan, hand: str) -> np.ndarray:
     """The grip point on a hand (its body frame, m): halfway down it."""
     seg = plan[SEGMENTS.index(hand)]
@@ -211,7 +229,7 @@ def _seated(params: FigureParams, p: SwingParams):
                       for h in ("l_hand", "r_hand")])
     thigh = plan[SEGMENTS.index("l_thigh")]
     hip_z = data.xpos[body["l_thigh"]][2]
-    seat_top = p.bar - p.chain
+    seat_top = p.bar - p.chain + p.sit_gap
     shift = np.array([-grips[:, 0].mean(), 0.0, seat_top - (hip_z - thigh.shape[1])])
     grips = grips + shift
     head = plan[SEGMENTS.index("head")]
