@@ -2,8 +2,9 @@
 the rigid parts of another system (a cord's two ankle straps tied to a figure's ankles, a kite's
 sail tied along its spars, its bridle to the frame, its lines to a pilot's handles). Two-way or
 one-way. One interaction carries all the ties between a network and a body, so its force log
-is the whole pull of the network on it; the ties are evaluated together (no Python loop per
-tie) and each tied part gets one wrench, the sum of its ties'."""
+is the whole pull of the network on it; the ties are evaluated together, in one kernel call
+per stage (``kernels.attachment``: no Python per tie), and each tied part gets one wrench, the
+sum of its ties'."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -11,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
+from ..kernels import attachment as K
 from ..params import param
 from .base import Interaction
 
@@ -84,6 +86,11 @@ class SegmentAttachment(Interaction):
         self._last = np.full(3, np.nan)  # m/s: the carrying part's velocity a step ago
         self._p = np.zeros((n, 3))
         self._v = np.zeros((n, 3))
+        self._force = np.zeros((len(self._uniq), 3))  # per tied part: N
+        self._moment = np.zeros((len(self._uniq), 3))  # N m
+        m = len(self.net.x)
+        self._r = np.zeros((m, 3))  # a carried network's points from the part's centre (m)
+        self._load = np.zeros((m, 3))  # their loads but the ties' (N)
         self._h = 0.0
 
     def _tie_points(self):
@@ -91,9 +98,8 @@ class SegmentAttachment(Interaction):
         state (a figure's advance leaves its kinematics and velocities current)."""
         pos, R = self.body.poses()
         lin, ang = self.body.velocities(self._uniq)
-        com = self.body.centres()[self.parts]
-        self._p[:] = pos[self.parts] + np.einsum("kij,kj->ki", R[self.parts], self.local)
-        self._v[:] = lin[self._inv] + np.cross(ang[self._inv], self._p - com)
+        K.tie_points(pos, R, self.body.centres(), lin, ang, self.parts, self._inv, self.local,
+                     self._p, self._v)
 
     def prepare(self, h, dts=None):
         self._h = h
@@ -104,7 +110,7 @@ class SegmentAttachment(Interaction):
         the step (``vref``), and ``complete`` gives the body the force the network felt."""
         self._tie_points()
         net, i = self.net, self.index
-        self._f[:] = self.k * (net.x[i] - self._p) + self.c * (net.v[i] - self._v)
+        K.tie_forces(net.x, net.v, i, self._p, self._v, 0.0, self.k, self.c, self._f)
         if to_secondary:
             self._held[:] = -self._f
             net.apply(i, self._held, self._jac, self._djac, self._v)
@@ -121,8 +127,7 @@ class SegmentAttachment(Interaction):
         net, i = self.net, self.index
         if self.carry:
             return self._carry(to_primary)
-        target = self._p + self._h * self._v
-        self._f[:] = self.k * (net.x[i] - target) + self.c * (net.v[i] - self._v)
+        K.tie_forces(net.x, net.v, i, self._p, self._v, self._h, self.k, self.c, self._f)
         return self._finish(to_primary)
 
     def capture(self) -> dict:
@@ -134,16 +139,13 @@ class SegmentAttachment(Interaction):
     def _finish(self, to_primary):
         """Each tied part gets the sum of its ties' forces at its centre of mass and the sum
         of their moments about it (the same wrench as each force at its own point)."""
+        total, torque = K.tie_wrenches(self._p, self._f, self.body.centres(), self.parts,
+                                       self._inv, self.body.centre_of_mass(), self._force,
+                                       self._moment)
         if to_primary:
-            r = self._p - self.body.centres()[self.parts]
-            force = np.zeros((len(self._uniq), 3))
-            moment = np.zeros((len(self._uniq), 3))
-            np.add.at(force, self._inv, self._f)
-            np.add.at(moment, self._inv, np.cross(r, self._f))
             for u, part in enumerate(self._uniq):  # once per part, not per tie
-                self.body.apply(int(part), force[u], torque=moment[u])
-        torque = np.cross(self._p - self.body.centre_of_mass(), self._f).sum(axis=0)
-        return self._f.sum(axis=0), torque, True
+                self.body.apply(int(part), self._force[u], torque=self._moment[u])
+        return total, torque, True
 
     def _carry(self, to_primary):
         """Give the part the network to carry: its mass, its inertia about the part's centre
@@ -155,20 +157,25 @@ class SegmentAttachment(Interaction):
         weight would turn a falling frame), taken over the last step (explicit: S is
         centimetre-kilograms beside the inertia)."""
         net, part = self.net, int(self._uniq[0])
-        load = net.accelerations() * net.masses[:, None]
-        np.subtract.at(load, self.index, self._held)
         c = self.body.centres()[part]
-        r = net.x - c
-        force, moment = load.sum(axis=0), np.cross(r, load).sum(axis=0)
+        force, moment, mass_moment = K.carried_load(net.x, net.accelerations(), net.masses,
+                                                    self.index, self._held, c, self._r,
+                                                    self._load)
         lin = self.body.velocities(self._uniq)[0][0]
         if np.all(np.isfinite(self._last)) and self._h > 0.0:
-            a = (lin - self._last) / self._h
-            moment -= np.cross((net.masses[:, None] * r).sum(axis=0), a)
+            moment -= _cross(mass_moment, (lin - self._last) / self._h)
         self._last[:] = lin
         if to_primary:
-            m = net.masses
+            m, r = net.masses, self._r
             inertia = (m * np.einsum("ki,ki->k", r, r)).sum() * np.eye(3) - np.einsum(
                 "k,ki,kj->ij", m, r, r)
             self.body.apply(part, force, torque=moment, carried=(m.sum(), inertia))
-        torque = moment + np.cross(c - self.body.centre_of_mass(), force)
+        torque = moment + _cross(c - self.body.centre_of_mass(), force)
         return force, torque, True
+
+
+def _cross(a, b):
+    """a x b of two 3-vectors as np.cross computes it, without its general-shape overhead
+    (several microseconds; twice per coupling step of a carried network)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])

@@ -125,6 +125,7 @@ class Pilot(System, RigidParts):
         self.hv = np.zeros_like(self.hx)
         self.target = self.rest.copy()
         self.controller = controller
+        self._posed = None  # the handles and stance the pose was made for
         self._pose()
         meshes = [segment_mesh(s.shape) for s in self.plan]
         handle = segment_mesh(("capsule", HANDLE_RADIUS, np.array([0, 0, -HANDLE_LENGTH / 2]),
@@ -142,7 +143,14 @@ class Pilot(System, RigidParts):
     # --- the pose ----------------------------------------------------------------------------
     def _pose(self):
         """Segment origins (17,3) and rotations (17,3,3) from the handles: the body in its rest
-        pose turned and leaned, the arms reaching the grips."""
+        pose turned and leaned, the arms reaching the grips; and the parts' poses as the
+        contact view reads them. A pose is a function of the handles and the stance alone, so
+        a flyer standing still (a single-line kite's: its handle at rest) is posed once, not
+        at every step."""
+        key = self.hx.tobytes() + self.base.tobytes()
+        if key == self._posed:
+            return
+        self._posed = key
         R0 = self.R0
         pos, rot = np.zeros((17, 3)), np.zeros((17, 3, 3))
         for k, s in enumerate(self.plan):
@@ -171,6 +179,12 @@ class Pilot(System, RigidParts):
             pos[hd] = elbow + rot[fa] @ self.plan[hd].offset
             rot[hd] = rot[fa]
         self.seg_pos, self.seg_rot = pos, rot
+        k = len(self.hx)
+        self._poses = (np.concatenate([pos, self.hx]),
+                       np.concatenate([rot, np.broadcast_to(R0, (k, 3, 3))]))
+        self._quats = None  # the frame's orientations, made when a frame is first asked for
+        m = np.array([s.mass for s in self.plan])
+        self._com = (m[:, None] * pos).sum(axis=0) / m.sum()
 
     # --- dynamics ------------------------------------------------------------------------------
     @property
@@ -223,9 +237,7 @@ class Pilot(System, RigidParts):
         return self._view
 
     def part_poses(self):
-        k = len(self.hx)
-        return (np.concatenate([self.seg_pos, self.hx]),
-                np.concatenate([self.seg_rot, np.broadcast_to(self.R0, (k, 3, 3))]))
+        return self._poses  # made by _pose; callers read it, as they read a body's live state
 
     def part_centres(self):
         return self.part_poses()[0]
@@ -238,8 +250,7 @@ class Pilot(System, RigidParts):
         return lin[rows], np.zeros_like(lin[rows])
 
     def centre_of_mass(self):
-        m = np.array([s.mass for s in self.plan])
-        return (m[:, None] * self.seg_pos).sum(axis=0) / m.sum()
+        return self._com
 
     def shapes(self):
         parts = [tuple(np.asarray(a) for a in segment_mesh(s.shape)) for s in self.plan]
@@ -291,5 +302,6 @@ class Pilot(System, RigidParts):
 
     def frame(self):
         pos, rot = self.part_poses()
-        return {"segment_positions": pos.copy(),
-                "segment_orientations": np.array([_quat(R) for R in rot])}
+        if self._quats is None:
+            self._quats = np.array([_quat(R) for R in rot])
+        return {"segment_positions": pos.copy(), "segment_orientations": self._quats.copy()}

@@ -108,9 +108,14 @@ class WindField(Stateless):
         rows = [np.c_[np.full(TURBULENCE_MODES, q), p.modes()]
                 for q, p in enumerate(self.primitives) if p.kind == "turbulence"]
         self._modes = np.concatenate(rows) if rows else np.zeros((0, 8))
+        self._at = (None, None)  # (t, arrays): every interaction of a coupling step asks at t
 
     def arrays(self, t: float):
-        """(kind, centre, axis, strength, core) arrays of the primitives at time t."""
+        """(kind, centre, axis, strength, core) arrays of the primitives at time t (s): a
+        function of t alone (the primitives are frozen, their paths functions of time), so
+        the last time's are kept for the next interaction that samples the field then."""
+        if self._at[0] == t:
+            return self._at[1]
         n = len(self.primitives)
         kind = np.empty(n, np.int64)
         centre, axis = np.empty((n, 3)), np.empty((n, 3))
@@ -128,6 +133,7 @@ class WindField(Stateless):
             if p.kind == "boundary_layer":  # the kernel's profile is ln(1 + z/z0)
                 strength[q] /= math.log1p(p.height / p.core)
             core[q] = p.core
+        self._at = (t, (kind, centre, axis, strength, core))
         return kind, centre, axis, strength, core
 
     def velocity(self, points, t: float) -> np.ndarray:
