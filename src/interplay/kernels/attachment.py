@@ -58,22 +58,21 @@ def tie_wrenches(p, f, centres, parts, inv, com, force, moment):
         r1 = p[j, 1] - centres[q, 1]
         r2 = p[j, 2] - centres[q, 2]
         f0, f1, f2 = f[j, 0], f[j, 1], f[j, 2]
-        force[u, 0] += f0
-        force[u, 1] += f1
-        force[u, 2] += f2
-        moment[u, 0] += r1 * f2 - r2 * f1
-        moment[u, 1] += r2 * f0 - r0 * f2
-        moment[u, 2] += r0 * f1 - r1 * f0
-        s0 = p[j, 0] - com[0]
-        s1 = p[j, 1] - com[1]
-        s2 = p[j, 2] - com[2]
-        total[0] += f0
-        total[1] += f1
-        total[2] += f2
-        torque[0] += s1 * f2 - s2 * f1
-        torque[1] += s2 * f0 - s0 * f2
-        torque[2] += s0 * f1 - s1 * f0
+        _add_force(force[u], moment[u], r0, r1, r2, f0, f1, f2)
+        _add_force(total, torque, p[j, 0] - com[0], p[j, 1] - com[1], p[j, 2] - com[2],
+                   f0, f1, f2)
     return total, torque
+
+
+@njit(cache=True, inline="always")
+def _add_force(force, moment, r0, r1, r2, f0, f1, f2):
+    """force (3,) += f, moment (3,) += r x f (r from the point the moment is about)."""
+    force[0] += f0
+    force[1] += f1
+    force[2] += f2
+    moment[0] += r1 * f2 - r2 * f1
+    moment[1] += r2 * f0 - r0 * f2
+    moment[2] += r0 * f1 - r1 * f0
 
 
 @njit(cache=True)
@@ -95,13 +94,7 @@ def carried_load(x, acc, m, index, held, centre, r, load):
     mass_moment = np.zeros(3)
     for i in range(n):
         r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
-        l0, l1, l2 = load[i, 0], load[i, 1], load[i, 2]
-        force[0] += l0
-        force[1] += l1
-        force[2] += l2
-        moment[0] += r1 * l2 - r2 * l1
-        moment[1] += r2 * l0 - r0 * l2
-        moment[2] += r0 * l1 - r1 * l0
+        _add_force(force, moment, r0, r1, r2, load[i, 0], load[i, 1], load[i, 2])
         mass_moment[0] += m[i] * r0
         mass_moment[1] += m[i] * r1
         mass_moment[2] += m[i] * r2
