@@ -6,7 +6,10 @@ garments' pass simulated for ``--seconds`` of the clip, ``repeats`` times: outpu
 1/30 s per wall second of the secondary pass (the garments with their skin contact and the
 per-frame certificates, which are timed apart: the same run with the certificates off), the
 vertex counts, and the load average. The issue asks for the same garment, body and motion in
-MuJoCo's flex cloth as a peer in the same run: not built (docs/clothing.md says why).
+MuJoCo's flex cloth as a peer in the same run: ``peer.mujoco_flex``
+(peer_mujoco_garments.py: the same dressed garments at t = 0 on the segments' primitives
+driven by the clip), over ``--peer-seconds`` of the clip (a MuJoCo step takes seconds
+here), compared with ours at the same time.
 Run: ``.venv/bin/python benchmarks/bench_runner.py --out out/bench [--quick]``.
 """
 from __future__ import annotations
@@ -27,12 +30,25 @@ def one(seconds: float, certify: bool) -> tuple[float, dict]:
     res = scene.simulate()
     wall = time.perf_counter() - t0
     garments = res.timings()["passes"][1]["wall_s"]
-    return garments, {"total_wall_s": wall, "meta": scene.meta}
+    return garments, {"total_wall_s": wall, "meta": scene.meta, "x": net.x.copy()}
+
+
+def peer(seconds: float) -> dict:
+    """MuJoCo's flex on the runner (peer_mujoco_garments.peer_row), against ours at the
+    same time."""
+    _, info = one(seconds, False)
+    scene = RN.build(duration=seconds, fps=30.0)
+    net = next(s for s in scene.systems if s.name == "clothes")
+    surface, clothes, _, _, x, v, _ = next(iter(RN._DRESSED.values()))
+    from peer_mujoco_garments import peer_row
+    return peer_row(scene.primary, surface, clothes, net.pinned, x, v, info["x"], seconds)
 
 
 def main():
-    args, repeats = parse_args(__doc__, lambda ap: ap.add_argument("--seconds", type=float,
-                                                                    default=1.0))
+    def extra(ap):
+        ap.add_argument("--seconds", type=float, default=1.0)
+        ap.add_argument("--peer-seconds", type=float, default=0.1)
+    args, repeats = parse_args(__doc__, extra)
     seconds = 0.3 if args.quick else args.seconds
     one(0.05, False)  # build, cut, dress and compile once: later builds reuse the dressing
     rows = {}
@@ -49,7 +65,7 @@ def main():
     out = {"machine": machine(), "seconds": seconds, "vertices": meta["vertices"],
            "cloth_dt_s": RN.RunnerParams().cloth_dt, "runs": rows,
            "target_frames_per_wall_s": 1.0,
-           "peer": {"mujoco_flex": "not built (docs/clothing.md)"}}
+           "peer": {"mujoco_flex": peer(1.0 / 30.0 if args.quick else args.peer_seconds)}}
     print(write_json(args.out, "bench_runner.json", out))
 
 
