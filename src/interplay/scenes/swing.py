@@ -20,9 +20,8 @@ import numpy as np
 
 from ..control.fsm import Controller, State
 from ..control.pump import Pump, PumpParams
-from ..geometry.anthropometry import BodyParams
+from ..geometry.anthropometry import SEGMENTS, BodyParams
 from ..geometry.body_surface import SurfaceParams, figure_surface
-from ..geometry.anthropometry import SEGMENTS
 from ..geometry.garment import Fit, skirt
 from ..interactions.part_contact import PartContact, PartContactParams
 from ..interactions.skin_contact import PosedSkin, SkinContact, SkinContactParams
