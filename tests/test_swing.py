@@ -137,3 +137,19 @@ def test_bad_swings_are_refused_in_one_line(swing, match):
     with pytest.raises(ParameterError, match=match) as err:
         S.child(replace(S.SwingSceneParams(), swing=swing))
     assert "\n" not in str(err.value)
+
+
+def test_a_contact_with_a_part_she_does_not_have_is_refused_in_one_line():
+    # the swing is her 18th part (its seat collides with the skirt); a misspelt part is named
+    # with the parts there are
+    from interplay.errors import SceneError
+    from interplay.interactions.part_contact import PartContact
+    from interplay.systems.springmass import SpringNetwork, Springs
+    fig = S.child(S.SwingSceneParams())
+    assert fig.contact_view().names[-1] == "swing"
+    x = np.array([[0.0, 0.0, 0.6], [0.1, 0.0, 0.6]])
+    net = SpringNetwork("cord", x, np.full(2, 0.01), Springs.from_ratio(x, [[0, 1]], 10.0))
+    PartContact("seat", fig, net, parts=("swing",))  # the seat alone: accepted
+    with pytest.raises(SceneError, match="has no parts seat; its parts are pelvis") as err:
+        PartContact("seat", fig, net, parts=("seat",))
+    assert "\n" not in str(err.value)
