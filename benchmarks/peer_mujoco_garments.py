@@ -174,6 +174,8 @@ def run(runner, surface, clothes, pinned, x, v, seconds: float, dt: float,
     within ``bound``'s "max" and "p99": ours at the same time, whose dressed state already
     strains some edges far past their cut length)."""
     import mujoco
+    log = []
+    mujoco.set_mju_user_warning(log.append)  # keep MUJOCO_LOG.TXT out of the working tree
     t0 = time.perf_counter()
     model, data, info = build(mujoco, runner, surface, clothes, pinned, x, v, dt)
     build_s = time.perf_counter() - t0
@@ -197,7 +199,7 @@ def run(runner, surface, clothes, pinned, x, v, seconds: float, dt: float,
             "s_per_step": wall / steps, "build_s": build_s,
             "ok": finite and bad == 0 and all(strain[k] <= bound[k] for k in bound),
             "strain": strain,
-            "bad_qacc_warnings": bad, "contacts_max": ncon, "x": end,
+            "bad_qacc_warnings": bad, "mujoco_warnings": len(log), "contacts_max": ncon, "x": end,
             "nv": int(model.nv), "nflexvert": int(model.nflexvert),
             "materials": info["materials"]}
 
