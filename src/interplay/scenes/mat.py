@@ -35,6 +35,7 @@ from ..outputs.render.camera import Camera
 from ..params import param
 from ..scene import Scene
 from ..systems.colliders import StaticBox
+from ..systems.relaxation import relax
 from ..systems.springmass import SpringNetwork, Springs
 from ..systems.static import StaticPlane
 from .contract import SceneSpec
@@ -102,20 +103,16 @@ def press(net, load: float, half: float = FEET_HALF, seconds: float = 0.4,
     (N) spread evenly over the top points within ``half`` (m) of the centre (two feet side by
     side), by heavily damped backward-Euler steps; returns the depression (m) of the top's
     lowest point below its rest height. Leaves the network at that rest, unloaded."""
-    from ..kernels import springs as K
     sel = pressed_points(net, half)
     saved, fixed = net.fext.copy(), net.fixed.copy()
     net.fixed[net.bottom] = True
     net.fext[:] = 0.0
-    bundle = net.bundle(alpha=damping)
-    scheme = K.Scheme(True, 1.0, False, 1e-10, 4000, net.xp, net.vp)
-    n = int(round(seconds / h))
-    for k in range(n):
+
+    def ramp(k, n):
         # the load ramps up over the first half: a sudden load would throw the top
         # layer past where it rests (a lattice can snap through; the foam would not)
         net.fext[sel, 2] = -load / len(sel) * min(1.0, 2.0 * (k + 1) / n)
-        K.implicit_step(bundle, net._load, net._f, h, scheme, False)
-    net.v[:] = 0.0
+    relax(net, seconds, h, damping, 4000, ramp)
     net.fext[:] = saved
     net.fixed[:] = fixed
     return float(net.rest_height - net.x[net.top, 2].min())
@@ -128,19 +125,15 @@ def press_flat(net, depth: float, half: float = FEET_HALF, seconds: float = 0.4,
     the mat relaxed by damped backward Euler, bottom layer held; returns the load (N) the
     sole carries then (the springs' push on the held points less their weight). Leaves the
     network at rest, unloaded."""
-    from ..kernels import springs as K
     sel = pressed_points(net, half)
     x0, fixed = net.x.copy(), net.fixed.copy()
     net.fixed[net.bottom] = True
     net.fixed[sel] = True
-    bundle = net.bundle(alpha=damping)
-    scheme = K.Scheme(True, 1.0, False, 1e-10, 4000, net.xp, net.vp)
-    n = int(round(seconds / h))
-    for k in range(n):
+
+    def lower(k, n):
         # lowered over the first half, as ``press`` ramps its load (no snap-through)
         net.x[sel, 2] = x0[sel, 2] - depth * min(1.0, 2.0 * (k + 1) / n)
-        K.implicit_step(bundle, net._load, net._f, h, scheme, False)
-    net.v[:] = 0.0
+    relax(net, seconds, h, damping, 4000, lower)
     load = float(net.internal_forces()[sel, 2].sum())
     net.x[:], net.fixed[:] = x0, fixed
     return load

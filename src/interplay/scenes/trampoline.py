@@ -36,6 +36,7 @@ from ..scene import Scene
 from ..systems.colliders import StaticMesh
 from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
+from ..systems.relaxation import relax
 from ..systems.springmass import SpringNetwork, Springs
 from ..systems.static import StaticPlane
 from ..params import param
@@ -137,16 +138,11 @@ def press(net: SpringNetwork, load: float, half: float = 0.15, seconds: float = 
     within ``half`` (m) of its centre in x and y (two feet side by side: a 0.3 m square), by
     heavily damped backward-Euler steps; returns the depression (m) of its lowest point below
     the rest plane. The network's own state is left at that rest."""
-    from ..kernels import springs as K
     sel = pressed_points(net, half)
     saved = net.fext.copy()
     net.fext[:] = 0.0
     net.fext[sel, 2] = -load / len(sel)
-    bundle, scheme = net.bundle(alpha=damping), K.Scheme(True, 1.0, False, 1e-10, 2000, net.xp,
-                                                          net.vp)
-    for _ in range(int(round(seconds / 2e-3))):
-        K.implicit_step(bundle, net._load, net._f, 2e-3, scheme, False)
-    net.v[:] = 0.0
+    relax(net, seconds, 2e-3, damping, 2000)
     net.fext[:] = saved
     return float(net.rest_height - net.x[:net.bed_points, 2].min())
 

@@ -11,8 +11,6 @@ al. 2013: a prefactored constant matrix and per-spring projections; ``kernels/lo
 """
 from __future__ import annotations
 
-import hashlib
-from collections import OrderedDict
 import numpy as np
 
 from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
@@ -37,29 +35,6 @@ LG_SOLVERS = ("auto", "direct", "multigrid")
 # 0.16 ms against 0.37 ms for the factored solve, at 32^2 they are even, and the factor's cost
 # grows as n^1.25)
 MULTIGRID_MIN_POINTS = 4000
-
-
-#: settled positions by network digest (oldest dropped first); a few networks' worth
-SETTLED_KEPT = 8
-_SETTLED: OrderedDict[bytes, np.ndarray] = OrderedDict()
-
-
-def _digest(*parts) -> bytes:
-    """A digest of arrays, tuples of them (the kernels' bundles) and scalars."""
-    h = hashlib.blake2b(digest_size=20)
-
-    def feed(o):
-        if isinstance(o, np.ndarray):
-            h.update(f"{o.dtype}{o.shape}".encode())
-            h.update(np.ascontiguousarray(o).tobytes())
-        elif isinstance(o, tuple):
-            for e in o:
-                feed(e)
-        else:
-            h.update(repr(o).encode())
-    for p in parts:
-        feed(p)
-    return h.digest()
 
 
 class SpringNetwork(System):
@@ -497,27 +472,10 @@ class SpringNetwork(System):
         self.time += h
 
     def settle(self, seconds=1.0, h=2e-3, damping=30.0):
-        """Let the network sag to rest under gravity alone (implicit, heavily damped), v = 0
-        after. The sag is a pure function of the network, so it is remembered for the
-        process: compare's builds of one scene, a sweep worker's runs and the tests settle
-        each distinct network once (a trampoline bed takes seconds)."""
-        net = self.bundle(alpha=damping)
-        key = _digest(net, self._load[1:], seconds, h)  # the load but for fext, zeroed here
-        if key not in _SETTLED:
-            saved = self.fext.copy()
-            self.fext[:] = 0.0
-            try:
-                scheme = K.Scheme(True, 1.0, False, 1e-10, 1000, self.xp, self.vp)
-                for _ in range(int(round(seconds / h))):
-                    K.implicit_step(net, self._load, self._f, h, scheme, False)
-            finally:
-                self.fext[:] = saved
-            _SETTLED[key] = self.x.copy()
-            while len(_SETTLED) > SETTLED_KEPT:
-                _SETTLED.popitem(last=False)
-        self.x[:] = _SETTLED[key]
-        self.v[:] = 0.0
-        self.has_prev = False
+        """Let the network sag to rest under gravity alone (``relaxation.settle``: implicit,
+        heavily damped, remembered per network for the process), v = 0 after."""
+        from .relaxation import settle
+        settle(self, seconds, h, damping)
 
     # --- measures --------------------------------------------------------------------------
     def strain(self) -> float:
