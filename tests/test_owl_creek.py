@@ -119,7 +119,7 @@ def test_noose_row_against_table_one(runs):
     res, _ = runs["two-way"]
     row = next(s for s in res.interaction_stats() if s["name"] == "noose")
     f, a = row["force_N"], row["acceleration_m_s2"]
-    assert row["contact_s"][0] > OPENS  # the rope's work, after the drop
+    assert row["contact_s"][0] >= OPENS  # the rope's work, from the drop on (it never leaves him)
     for k, paper in (("max", PAPER["force_N"][1]), ("mean", PAPER["force_N"][2])):
         assert paper / 2 <= f[k] <= 2 * paper, (k, f[k], paper)
     assert PAPER["acceleration_m_s2"][2] / 2 <= a["mean"] <= 2 * PAPER["acceleration_m_s2"][2]
@@ -192,7 +192,7 @@ def test_vest_row_against_table_one(vested):
     res, _ = vested["one-way"]
     row = next(s for s in res.interaction_stats() if s["name"] == "vest")
     f, a = row["force_N"], row["acceleration_m_s2"]
-    assert row["mode"] == "one-way" and row["contact_s"][0] > OPENS
+    assert row["mode"] == "one-way" and row["contact_s"][0] >= OPENS
     paper = PAPER_VEST["force_N"][2]
     assert paper / 2 <= f["mean"] <= 2 * paper, (f["mean"], paper)
     paper_a = PAPER_VEST["acceleration_m_s2"][2]
@@ -204,11 +204,10 @@ def test_vest_row_against_table_one(vested):
     assert res.advice_for(res.interaction("vest"))["mode"] == "one-way"
 
 
-@pytest.mark.xfail(strict=True, reason="issue 20's bar, not met: the vest's peak is ~3.3x the "
-                   "paper's 31.9 N; at the jerk his torso decelerates at ~150-200 m/s^2 and the "
-                   "vest on it with him (docs/owl-creek.md)")
 @pytest.mark.slow
 def test_vest_peak_force_within_twice_the_paper(vested):
+    """The vest's peak pull within x2 of the paper's 31.9 N: it lands on his shoulders as the
+    rope stops him (its peak ~25 ms after the rope's), at the paper's peak rope pull."""
     res, _ = vested["one-way"]
     row = next(s for s in res.interaction_stats() if s["name"] == "vest")
     paper = PAPER_VEST["force_N"][1]

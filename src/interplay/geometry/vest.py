@@ -26,9 +26,8 @@ from ..params import param
 
 @dataclass(frozen=True)
 class VestParams:
-    """enabled: dress him in it (off by default: above ~1e-4 s the vest sinks into him by
-    more than its skin at the jerk, and at 1e-4 s it costs several times the rest of the
-    scene: docs/owl-creek.md); coupling: the vest's (one-way: its pull on him is measured,
+    """enabled: dress him in it (its one-way pass, at the 1e-4 s the jerk needs, costs several
+    times the rest of the scene: false leaves it out; docs/owl-creek.md); coupling: the vest's (one-way: its pull on him is measured,
     not applied); mass (kg, the paper's 0.5 kg: a heavy lined vest); ease (m): its clearance
     outside the torso; hem (m): its lower edge above the torso's bottom (the waist: the bound
     forearms cross behind the back below it); neck (m): half the neckline's width, the
@@ -38,7 +37,7 @@ class VestParams:
     the vest's own density (docs/owl-creek.md); dt (s): its step (implicit) and cg_tolerance
     its solve's relative residual (the flags'); damping (s): stiffness-proportional, the
     fabric's hysteresis (a dropped garment does not spring back)."""
-    enabled: bool = param(False, doc="true: dress him in it (slow: docs/owl-creek.md)")
+    enabled: bool = param(True, doc="false: no vest (its pass is the scene's slowest)")
     coupling: str = param("one-way", choices=("one-way", "two-way"))
     mass: float = param(0.5, "kg", ge=0.01, le=20.0)
     ease: float = param(0.01, "m", ge=0.002, le=0.1)
