@@ -61,7 +61,8 @@ bench-cloth: $(STAMP)
 clean:
 	rm -rf $(VENV) out .pytest_cache build src/*.egg-info
 
-# Numba's cache does not track kernels called across modules: clear it after editing kernels.
+# Numba's cache (kernel edits do not need this: the cache folder is keyed by every kernel's
+# source, src/interplay/kernels/__init__.py); for a first run on an empty cache
 clean-numba:
 	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
 

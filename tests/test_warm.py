@@ -37,3 +37,23 @@ def test_an_unknown_scene_is_one_line_before_any_worker_starts(tmp_path):
     r = interplay("warm", "flgas", cache=tmp_path)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
     assert "flgas" in r.stderr
+
+
+def test_the_cache_folder_is_keyed_by_every_kernels_source(tmp_path):
+    """A caller's cached machine code has its callees compiled in, and Numba checks a cached
+    kernel against its own file only: so every kernel's cache lives in the folder named after
+    all kernel sources, and an edit of any one of them (here a callee's copy) names a new one."""
+    import shutil
+
+    import interplay.kernels as K
+    from interplay.kernels import contact_law, springs
+    folder = K._cache_folder()
+    for kernel in (springs.implicit_step, contact_law.normal_force):
+        assert Path(kernel._cache._cache_path).is_relative_to(folder)
+    copy = tmp_path / "kernels"
+    shutil.copytree(K._HERE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    before = K._source_hash(copy)
+    with open(copy / "contact_law.py", "a") as f:
+        f.write("\n# an edit\n")
+    assert K._source_hash(copy) != before
+    assert before == K._source_hash()
