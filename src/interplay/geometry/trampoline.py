@@ -34,7 +34,11 @@ class BedParams:
     bending springs;
     mass_damping (1/s), stiffness_damping (s): Rayleigh; dt (s): the bed's step (explicit:
     below the stability bound the builder reports); thickness (m): half the bed's thickness,
-    its contact skin."""
+    its contact skin; fine_x, fine_y (m): half extents of a central zone whose cells are
+    halved along x and along y (0: none), so the bed resolves a foot where she lands
+    (docs/trampoline.md: a foot narrower than a facet chatters); the webbing's stiffness per
+    width, mass per area and the frame springs' per length of edge stay those of the coarse
+    grid, so its load-deflection does too."""
     length: float = param(4.28, "m", gt=0.0, le=50.0)
     width: float = param(2.14, "m", gt=0.0, le=50.0)
     height: float = param(1.155, "m", gt=0.0, le=20.0, doc="the bed's rest plane")
@@ -52,6 +56,8 @@ class BedParams:
     stiffness_damping: float = param(1e-4, "s", ge=0.0, le=1.0)
     dt: float = param(1.25e-4, "s", gt=0.0, le=0.01)
     thickness: float = param(0.004, "m", gt=0.0, le=0.2, doc="contact skin")
+    fine_x: float = param(0.0, "m", ge=0.0, le=25.0, doc="central zone refined along x")
+    fine_y: float = param(0.0, "m", ge=0.0, le=25.0, doc="central zone refined along y")
 
     def validated(self) -> "BedParams":
         for name, unit in (("length", "m"), ("width", "m"), ("height", "m"), ("mass", "kg"),
@@ -120,26 +126,70 @@ def weave(nu: int, nv: int):
     return ij, kind
 
 
+def graded(length: float, n: int, fine: float) -> np.ndarray:
+    """Coordinates (m) of n points evenly spanning length centred on 0, with the midpoint
+    added in every cell that lies within |x| <= fine (m)."""
+    c = np.linspace(-length / 2, length / 2, n)
+    tol = 1e-9 * length
+    mid = [(a + b) / 2 for a, b in zip(c[:-1], c[1:]) if max(abs(a), abs(b)) <= fine + tol]
+    return np.sort(np.concatenate([c, mid]))
+
+
+def _widths(c: np.ndarray) -> np.ndarray:
+    """The width (m) of the strip each grid line carries: half of each neighbouring cell."""
+    d = np.diff(c)
+    return np.concatenate([[d[0] / 2], (d[:-1] + d[1:]) / 2, [d[-1] / 2]])
+
+
+def _refined_shares(p: BedParams, xs, ys, pairs, edge):
+    """For a graded grid: each spring's strip width over the coarse spacing (a diagonal: its
+    cell's size over the coarse cell's), each point's area (m^2), and each frame spring's
+    length of edge over the coarse spacing."""
+    nu = len(xs)
+    s = np.array([p.length / (p.nu - 1), p.width / (p.nv - 1)])
+    wx, wy = _widths(xs), _widths(ys)
+    area = np.outer(wy, wx).ravel()
+    wx[[0, -1]], wy[[0, -1]] = 2 * wx[[0, -1]], 2 * wy[[0, -1]]  # border lines: whole strips
+    iu, jv = pairs % nu, pairs // nu
+    cell = np.sqrt(np.abs(np.diff(xs[iu], axis=1)[:, 0] * np.diff(ys[jv], axis=1)[:, 0])
+                   / (s[0] * s[1]))
+    strip = np.where(jv[:, 0] == jv[:, 1], wy[jv[:, 0]] / s[1],
+                     np.where(iu[:, 0] == iu[:, 1], wx[iu[:, 0]] / s[0], cell))
+    ei, ej = edge % nu, edge // nu
+    ends = (ei == 0) | (ei == nu - 1)
+    side = np.where(ends, wy[ej] / s[1], wx[ei] / s[0])
+    side[ends & ((ej == 0) | (ej == len(ys) - 1))] = 1.0
+    return strip, area, side
+
+
 def build_bed(p: BedParams) -> Bed:
     """The bed grid centred on the origin at z = height, its frame springs and masses."""
     p = p.validated()
-    x, tris = shapes.grid(p.length, p.width, p.nu, p.nv,
-                          origin=(-p.length / 2, -p.width / 2, p.height))
-    edge, out = edge_points(p.nu, p.nv)
+    xs, ys = graded(p.length, p.nu, p.fine_x), graded(p.width, p.nv, p.fine_y)
+    nu, nv = len(xs), len(ys)
+    gx, gy = np.meshgrid(xs, ys)
+    x = np.stack([gx.ravel(), gy.ravel(), np.full(gx.size, p.height)], axis=1)
+    _, tris = shapes.grid(p.length, p.width, nu, nv)
+    edge, out = edge_points(nu, nv)
     n, e = len(x), len(edge)
-    pairs, kind = weave(p.nu, p.nv)
+    pairs, kind = weave(nu, nv)
     rest = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
-    k = np.array([p.stretch, p.shear, p.bend])[kind] / rest
-    # the webbing's mass by the area each point carries (a quarter of each cell at its
-    # corners: uniform inside, unlike a criss-cross triangulation's thirds); half of each
-    # spring's at its hook
-    share = np.ones((p.nv, p.nu))
-    share[[0, -1], :] *= 0.5
-    share[:, [0, -1]] *= 0.5
-    area = share.ravel()
-    masses = np.concatenate([area * (p.mass - p.spring_mass * e) / area.sum(),
-                             np.full(e, p.spring_mass / 2.0)])
-    masses[edge] += p.spring_mass / 2.0
+    # a spring stands for the strip of webbing across it: k = modulus x strip width / rest,
+    # the coarse grid's modulus being stretch (shear, bend) / its spacing; on the even grid
+    # the strip is the spacing (its border lines' too, as always): k = stretch / rest. The
+    # webbing's mass by the area each point carries (a quarter of each cell at its corners:
+    # uniform inside, unlike a criss-cross triangulation's thirds); half of each spring's at
+    # its hook. A frame spring stands for the length of edge its point carries (its
+    # stiffness, tension and mass scale with it; the corners' diagonal ones are whole)
+    strip, side = np.ones(len(pairs)), np.ones(e)
+    area = np.outer(np.r_[0.5, np.ones(nv - 2), 0.5], np.r_[0.5, np.ones(nu - 2), 0.5]).ravel()
+    if p.fine_x > 0.0 or p.fine_y > 0.0:
+        strip, area, side = _refined_shares(p, xs, ys, pairs, edge)
+    k = np.array([p.stretch, p.shear, p.bend])[kind] * strip / rest
+    springs = 2 * (p.nu + p.nv) - 4
+    masses = np.concatenate([area * (p.mass - p.spring_mass * springs) / area.sum(),
+                             side * p.spring_mass / 2.0])
+    masses[edge] += side * p.spring_mass / 2.0
     frame = np.arange(n, n + e)
     # k (l - rest) = spring_tension at l = gap; rest < 0 when the preload exceeds k gap (a
     # preloaded spring, never slack), else the spring goes slack below its rest length
@@ -147,7 +197,7 @@ def build_bed(p: BedParams) -> Bed:
     return Bed(np.vstack([x, x[edge] + p.gap * out]), masses, tris,
                np.concatenate([pairs[:, 0], edge]), np.concatenate([pairs[:, 1], frame]),
                np.concatenate([rest, np.full(e, spring_rest)]),
-               np.concatenate([k, np.full(e, p.spring_stiffness)]),
+               np.concatenate([k, side * p.spring_stiffness]),
                np.concatenate([np.zeros(len(rest), bool), np.full(e, spring_rest > 0)]),
                np.concatenate([kind, np.full(e, 3)]), frame, edge, n)
 
