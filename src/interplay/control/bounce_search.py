@@ -180,14 +180,14 @@ BOUNCE = Search(
     chains=4, t_start=1.0, t_end=0.01, step=0.1)
 
 
-def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float]:
+def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float, tuple]:
     """The BounceRecord of a finished run (a Result), rebuilt from its data: landings and
     takeoffs from the contact's force log (its periods of contact, 1 ms), the centre of mass
     and the pelvis's tilt from the gymnast's output frames (interpolated at the landings;
     apexes are frame maxima: at 60 frames/s within g (1/120 s)^2 / 2 = 0.3 mm), and the floor
     from her segments' lowest mesh point. Also returns each landing's bed depression (m,
-    below ``bed_height``, the frames' lowest bed point during the contact) and her lowest
-    point (m)."""
+    below ``bed_height``, the frames' lowest bed point during the contact), her lowest
+    point (m) and where her centre of mass was (x, y, m) when she was lowest."""
     from ..kernels.rigid import quat_to_matrix
     log = result.logs[result.main]
     fr = result.frames["gymnast"]
@@ -212,7 +212,8 @@ def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float]:
         if bed is not None and during.any():
             depressions.append(float(bed_height - bed[during][:, :, 2].min()))
         last = end
-    return rec, depressions, float(lowest.min())
+    k = int(np.argmin(lowest))
+    return rec, depressions, float(lowest[k]), (float(com[k, 0]), float(com[k, 1]))
 
 
 FLOOR_GAP = 0.02  # m: her lowest point this near the floor means the bed let her through

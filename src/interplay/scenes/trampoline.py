@@ -180,7 +180,8 @@ def build(coupling: str = "two-way", duration: float = 20.0, fps: float = 60.0,
     standin = BedSprings(params.standin, fig, centre[2] + params.contact.thickness)
     scene.connect(PartContact("gymnast-bed", fig, tramp, params.contact, mode=coupling,
                               standin=standin))
-    scene.meta = {"bed_height": params.bed.height, "centre_zone": list(CENTRE_ZONE)}
+    scene.meta = {"bed_height": params.bed.height, "centre_zone": list(CENTRE_ZONE),
+                  "bed_half": [params.bed.length / 2, params.bed.width / 2]}
     return scene
 
 
@@ -191,7 +192,7 @@ def figures(result) -> dict:
     reached the floor: the bed is too soft; she fell or left the central zone)."""
     from ..control.bounce_search import TILT_FALLEN, TILT_GOOD, record_of, rises, score
     height = result.meta["bed_height"]
-    rec, depressions, lowest = record_of(result, height)
+    rec, depressions, lowest, where = record_of(result, height)
     _, metrics = score(rec, tuple(result.meta["centre_zone"]))
     good = metrics["bounces"]
     rise = rises(rec)
@@ -203,7 +204,13 @@ def figures(result) -> dict:
            "flight_height_variation": (float((later.max() - later.min()) / later.mean())
                                        if len(later) > 1 else None),
            "lowest_point_m": round(lowest, 4), "warnings": []}
-    if rec.floor:
+    half = result.meta.get("bed_half", (np.inf, np.inf))
+    if rec.floor and (abs(where[0]) > half[0] or abs(where[1]) > half[1]):
+        # the frame and its springs are drawn, not collided: off the bed's edge she falls
+        out["warnings"].append(
+            f"she slid off the bed onto the floor at ({where[0]:.2f}, {where[1]:.2f}) m, past "
+            f"its edge (the frame and its springs do not hold her: they are drawn only)")
+    elif rec.floor:
         out["warnings"].append(
             f"bed too soft: the gymnast reached the floor (her lowest point {lowest:.3f} m, the "
             f"bed's rest plane {height} m up); raise bed.spring_tension or bed.stretch")
