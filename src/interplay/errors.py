@@ -3,6 +3,7 @@
 The CLI prints ``str(error)`` on one line and exits non-zero; nothing here carries a traceback
 worth showing to an animator.
 """
+import math
 
 
 class InterplayError(Exception):
@@ -51,3 +52,11 @@ def require_nonnegative(owner: str, name: str, value, unit: str = "") -> float:
         u = f" {unit}" if unit else ""
         raise ParameterError(f"{owner}: {name} must be zero or positive{u}, got {value!r}")
     return v
+
+
+def usable_below(bound: float) -> str:
+    """A limit (a stable step's) rounded down to 3 significant digits, as a message's advice:
+    rounded to nearest, "use dt <= 0.000125" could name the very step refused at a bound of
+    1.2499e-4."""
+    e = 10.0 ** (math.floor(math.log10(bound)) - 2)
+    return f"{math.floor(bound / e) * e:.3g}"

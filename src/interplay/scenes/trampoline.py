@@ -42,7 +42,7 @@ from ..systems.static import StaticPlane
 from ..params import param
 from .contract import SceneSpec
 
-from ..errors import StabilityError
+from ..errors import StabilityError, usable_below
 
 BED_COLOR = (0.05, 0.05, 0.06)  # the black webbing of a competition bed
 FRAME_COLOR = (0.1, 0.25, 0.6)  # painted steel (linear RGB)
@@ -123,7 +123,7 @@ def check_explicit(net: SpringNetwork, key: str = "bed.dt",
         raise StabilityError(
             f"{net.name}: dt={h:.3g} s is too large for its stiffness and damping (explicit "
             f"stability number {worst:.2f}, at most {EXPLICIT_SHARE}); use {key} <= "
-            f"{bound:.2g} s, or {cure}")
+            f"{usable_below(bound)} s, or {cure}")
 
 
 def pressed_points(net: SpringNetwork, half: float = 0.15) -> np.ndarray:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
-                      require_positive)
+                      require_positive, usable_below)
 from ..kernels import global_matrix as GM
 from ..kernels import localglobal as LG
 from ..kernels import multigrid as MG
@@ -259,7 +259,7 @@ class SpringNetwork(System):
             if dt >= bound:
                 raise StabilityError(
                     f"{self.name}: dt={dt:.3g} s is above the explicit stability bound "
-                    f"{bound:.3g} s; use dt < {bound:.3g} or --integrator implicit")
+                    f"{bound:.4g} s; use dt <= {usable_below(bound)} or --integrator implicit")
             # the springs' own damping can pass this bound where beta k could not (a scene's
             # own check, as the trampoline's check_explicit, names its keys for beta)
             own = bool(np.any(self.kd > self.beta * self.k))
