@@ -24,12 +24,16 @@ def reference(x, v, tris, wind, cn, ct):
     return f
 
 
-def test_kernel_matches_formula():
-    rng = np.random.default_rng(1)
+def random_sheet(seed):
+    """A jittered 5x4 sheet (m) with random point velocities and winds at its centroids (m/s)."""
+    rng = np.random.default_rng(seed)
     x, tris = shapes.grid(1.0, 0.7, 5, 4)
     x = x + rng.normal(0, 0.05, x.shape)
-    v = rng.normal(0, 2.0, x.shape)
-    wind = rng.normal(0, 3.0, (len(tris), 3))
+    return x, tris, rng.normal(0, 2.0, x.shape), rng.normal(0, 3.0, (len(tris), 3))
+
+
+def test_kernel_matches_formula():
+    x, tris, v, wind = random_sheet(1)
     f = np.zeros_like(x)
     total = K.triangle_forces(x, v, tris, wind, 0.7, 0.05, f, np.zeros((len(x), 3, 3)), False)
     assert np.allclose(f, reference(x, v, tris, wind, 0.7, 0.05), rtol=1e-10, atol=1e-13)
@@ -119,11 +123,7 @@ def spec_plate_force(x, v, tris, wind, cn, ct):
 def test_plate_law_is_bit_identical_to_spec():
     """The default law (and law="plate" through the interaction) is SPEC 2.2's to the bit:
     every scene that does not ask for the delta law moves exactly as before it existed."""
-    rng = np.random.default_rng(7)
-    x, tris = shapes.grid(1.0, 0.7, 5, 4)
-    x = x + rng.normal(0, 0.05, x.shape)
-    v = rng.normal(0, 2.0, x.shape)
-    wind = rng.normal(0, 3.0, (len(tris), 3))
+    x, tris, v, wind = random_sheet(7)
     f = np.zeros_like(x)
     K.triangle_forces(x, v, tris, wind, 0.7, 0.02, f, np.zeros((len(x), 3, 3)), False)
     assert np.array_equal(f, spec_plate_force(x, v, tris, wind, 0.7, 0.02))
