@@ -24,12 +24,16 @@ def reference(x, v, tris, wind, cn, ct):
     return f
 
 
-def test_kernel_matches_formula():
-    rng = np.random.default_rng(1)
+def random_sheet(seed):
+    """A jittered 5x4 sheet (m) with random point velocities and winds at its centroids (m/s)."""
+    rng = np.random.default_rng(seed)
     x, tris = shapes.grid(1.0, 0.7, 5, 4)
     x = x + rng.normal(0, 0.05, x.shape)
-    v = rng.normal(0, 2.0, x.shape)
-    wind = rng.normal(0, 3.0, (len(tris), 3))
+    return x, tris, rng.normal(0, 2.0, x.shape), rng.normal(0, 3.0, (len(tris), 3))
+
+
+def test_kernel_matches_formula():
+    x, tris, v, wind = random_sheet(1)
     f = np.zeros_like(x)
     total = K.triangle_forces(x, v, tris, wind, 0.7, 0.05, f, np.zeros((len(x), 3, 3)), False)
     assert np.allclose(f, reference(x, v, tris, wind, 0.7, 0.05), rtol=1e-10, atol=1e-13)
@@ -92,3 +96,83 @@ def test_aero_needs_a_surface():
     cord = SpringNetwork("cord", x, 1.0, Springs.from_ratio(x, [(0, 1)], 1.0))
     with pytest.raises(ParameterError, match="cord has no triangles"):
         Aerodynamics("air", WindField("w"), cord)
+
+
+def spec_plate_force(x, v, tris, wind, cn, ct):
+    """SPEC 2.2's law evaluated in plain Python floats in the kernel's own order of operations
+    (IEEE doubles, no fused or reordered arithmetic): the plate law must give these bits."""
+    f = np.zeros_like(x)
+    for t, (i, j, k) in enumerate(tris):
+        e1, e2 = [x[j, c] - x[i, c] for c in range(3)], [x[k, c] - x[i, c] for c in range(3)]
+        n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+             e1[0] * e2[1] - e1[1] * e2[0]]
+        a2 = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+        n = [c / a2 for c in n]
+        s = 0.5 * a2
+        r = [(v[i, c] + v[j, c] + v[k, c]) / 3.0 - wind[t, c] for c in range(3)]
+        speed = np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+        vn = n[0] * r[0] + n[1] * r[1] + n[2] * r[2]
+        cnn = -cn * s * speed * vn
+        fa = [cnn * n[c] - ct * s * (r[c] - vn * n[c]) for c in range(3)]
+        for p in (i, j, k):
+            for c in range(3):
+                f[p, c] += fa[c] / 3.0
+    return f
+
+
+def test_plate_law_is_bit_identical_to_spec():
+    """The default law (and law="plate" through the interaction) is SPEC 2.2's to the bit:
+    every scene that does not ask for the delta law moves exactly as before it existed."""
+    x, tris, v, wind = random_sheet(7)
+    f = np.zeros_like(x)
+    K.triangle_forces(x, v, tris, wind, 0.7, 0.02, f, np.zeros((len(x), 3, 3)), False)
+    assert np.array_equal(f, spec_plate_force(x, v, tris, wind, 0.7, 0.02))
+    net = SpringNetwork.from_mesh("sheet", x, tris, 0.1, stretch=20.0)
+    net.v[:] = v
+    field = WindField("w", [FlowPrimitive("uniform", strength=3.0, axis=(1, 0.2, 0.1))])
+    ref = Aerodynamics("a", field, net, AeroParams()).forces()[0].copy()
+    plate = Aerodynamics("b", field, net, AeroParams(law="plate", potential=4.0)).forces()[0]
+    assert np.array_equal(ref, plate)
+    w = np.tile(field.velocity(x[:1], 0.0)[0], (len(tris), 1))
+    assert np.array_equal(ref, spec_plate_force(x, v, tris, w, 0.7, 0.02))
+
+
+def polhamus(deg, kp, kv, stall, cn=0.7, rho=1.2):
+    """C_N of the delta law, written from Polhamus (1966) independently of the kernel: K_p sin
+    cos^2 + K_v sin^2 cos up to the stall, above it the larger of its value there and the
+    plate's 2 c_n / rho sin."""
+    def pol(a):
+        return kp * np.sin(a) * np.cos(a) ** 2 + kv * np.sin(a) ** 2 * np.cos(a)
+    a, s = np.radians(deg), np.radians(stall)
+    return pol(a) if a <= s else max(pol(s), 2 * cn / rho * np.sin(a))
+
+
+@pytest.mark.parametrize("deg", [5.0, 10.0, 20.0, 29.0, 45.0, 80.0])
+def test_delta_law_matches_polhamus(deg):
+    """One triangle at rest in a uniform wind, its plane at `deg` to the wind: the force is
+    q s C_N(a) along its normal plus the skin friction c_t s v along it, C_N from Polhamus's
+    closed form (at 20 deg, K_p = 2.5, K_v = pi: C_N = 1.10 against the plate law's 0.41).
+    The kernel and this evaluation differ only in the order of operations: rel 1e-12."""
+    kp, kv, stall, rho, ct, U = 2.5, np.pi, 30.0, 1.2, 0.02, 9.0
+    a = np.radians(deg)
+    # a right triangle of legs 1 and 0.8 (s = 0.4 m^2) in the plane holding y, tilted by a
+    x = np.array([[0.0, 0.0, 0.0], [np.cos(a), 0.0, np.sin(a)], [0.0, 0.8, 0.0]])
+    tris = np.array([[0, 1, 2]])
+    p = AeroParams(law="delta", potential=kp, vortex=kv, stall=stall, density=rho, friction=ct)
+    net = SpringNetwork.from_mesh("tri", x, tris, 0.01, stretch=20.0)
+    air = Aerodynamics("air", WindField("w", [FlowPrimitive("uniform", strength=U)]), net, p)
+    F = air.forces()[2]
+    n = np.array([-np.sin(a), 0.0, np.cos(a)])  # the unit normal (either sign: same force)
+    w = np.array([U, 0.0, 0.0])
+    q, s = 0.5 * rho * U * U, 0.4
+    expect = q * s * polhamus(deg, kp, kv, stall) * np.sign(w @ n) * n \
+        + ct * s * (w - (w @ n) * n)
+    assert np.allclose(F, expect, rtol=1e-12, atol=1e-12)
+    assert polhamus(20.0, kp, kv, stall) == pytest.approx(1.10, abs=0.005)
+
+
+def test_delta_law_refuses_an_unknown_law():
+    x, tris = shapes.grid(1.0, 1.0, 2, 2)
+    net = SpringNetwork.from_mesh("sheet", x, tris, 0.1, stretch=20.0)
+    with pytest.raises(ParameterError, match="unknown aerodynamic law 'wing'.*plate, delta"):
+        Aerodynamics("air", WindField("w"), net, AeroParams(law="wing"))

@@ -6,24 +6,47 @@ force on the primary is logged (the reaction the air would feel) and never appli
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, require_nonnegative
+from ..errors import ParameterError, require_nonnegative, require_positive
 from ..kernels import aero as K
 from ..params import param
 from .base import Interaction
 
 
+LAWS = ("plate", "delta")
+
+
 @dataclass(frozen=True)
 class AeroParams:
-    """Coefficients of f = -c_n s |v| (n.v) n - c_t s (v - (n.v) n).
+    """The air on each triangle: f = -c s |v| (n.v) n - c_t s (v - (n.v) n).
+
+    law: how the normal force's coefficient c (kg/m^3) depends on the triangle's angle of
+    attack a (sin a = |n.v| / |v|):
+
+    * ``plate`` (SPEC 2.2): c = drag, constant; the normal force coefficient C_N = 2 c / rho
+      = 1.2 sin a, a flat plate's across the flow and a third of a lifting sail's at 10-30
+      deg;
+    * ``delta``: Polhamus's leading-edge-suction analogy for a sharp-edged delta (NASA TN
+      D-3767, 1966), C_N = K_p sin a cos^2 a + K_v sin^2 a cos a (potential flow lift with
+      K_p the lift slope per radian, vortex lift with K_v ~ pi), i.e. c = 0.5 density (K_p
+      cos^2 a + K_v sin a cos a), up to ``stall``; above it the leading-edge vortex has burst
+      and C_N stays at its value there, or the plate's 2 drag / density sin a where that is
+      larger (the separated flow across a plate: ESDU 70015, 1970).
 
     drag: c_n (kg/m^3), 0.5 rho C_D with C_D ~ 1.2 for a flat plate across the flow;
-    friction: c_t (kg/(m^2 s)), linear skin friction along the surface."""
+    friction: c_t (kg/(m^2 s)), linear skin friction along the surface; density (kg/m^3),
+    potential (K_p, 1/rad), vortex (K_v) and stall (deg): the delta law's."""
     drag: float = param(0.7, "kg/m^3", ge=0.0, le=100.0, doc="c_n, 0.5 rho C_D")
     friction: float = param(0.02, "kg/(m^2 s)", ge=0.0, le=100.0, doc="c_t")
+    law: str = param("plate", "-", choices=LAWS, doc="normal force law")
+    density: float = param(1.2, "kg/m^3", gt=0.0, le=1500.0, doc="rho (delta law)")
+    potential: float = param(2.5, "1/rad", ge=0.0, le=6.3, doc="K_p (delta law)")
+    vortex: float = param(3.14, "-", ge=0.0, le=4.0, doc="K_v (delta law)")
+    stall: float = param(30.0, "deg", gt=0.0, le=90.0, doc="vortex breakdown (delta law)")
 
 
 class _AirOn(Interaction):
@@ -58,6 +81,7 @@ class Aerodynamics(_AirOn):
         self.tris = np.ascontiguousarray(self.body.triangles, dtype=np.int64)
         self.cn = require_nonnegative(name, "drag", params.drag, "kg/m^3")
         self.ct = require_nonnegative(name, "friction", params.friction, "kg/(m^2 s)")
+        self.law = _law(name, params)
         n = len(self.body.x)
         self._buffers(n)
         self._cent = np.zeros((len(self.tris), 3))
@@ -71,8 +95,27 @@ class Aerodynamics(_AirOn):
         if with_jacobian:
             self._dfdv[:] = 0.0
         total = K.triangle_forces(body.x, body.v, self.tris, wind, self.cn, self.ct, self._f,
-                                  self._dfdv, with_jacobian)
+                                  self._dfdv, with_jacobian, *self.law)
         return self._f, self._dfdv, total
+
+
+def _law(name, p: AeroParams):
+    """The kernel's (law, 0.5 rho K_p, 0.5 rho K_v, sin(stall), 0.5 rho C_N at the stall) for
+    ``p`` (the plate law ignores the last four)."""
+    if p.law not in LAWS:
+        raise ParameterError(f"interaction {name}: unknown aerodynamic law {p.law!r}; choose "
+                             f"one of {', '.join(LAWS)} (aero.law)")
+    if p.law == "plate":
+        return 0, 0.0, 0.0, 1.0, 0.0
+    half = 0.5 * require_positive(name, "density", p.density, "kg/m^3")
+    kp = require_nonnegative(name, "potential", p.potential, "1/rad")
+    kv = require_nonnegative(name, "vortex", p.vortex)
+    if not 0.0 < p.stall <= 90.0:
+        raise ParameterError(f"interaction {name}: stall {p.stall!r} deg is outside (0, 90]; "
+                             "the delta law's vortex bursts at 20-40 deg (aero.stall)")
+    a = math.radians(p.stall)
+    cs = kp * math.sin(a) * math.cos(a) ** 2 + kv * math.sin(a) ** 2 * math.cos(a)
+    return 1, half * kp, half * kv, math.sin(a), half * cs
 
 
 

@@ -7,7 +7,9 @@ its three points' velocities minus the wind at its centroid):
 
 The normal term is quadratic (pressure drag; at an angle of attack it has a component across
 the wind: lift), the tangential one linear (skin friction). It is the same for either normal
-orientation, so meshes need no consistent winding. Each point gets f / 3.
+orientation, so meshes need no consistent winding. Each point gets f / 3. The delta law
+(``interactions.aero.AeroParams``) replaces the constant c_n by one that depends on the
+triangle's angle of attack: f = -c(a) s |v| (n.v) n - c_t s (v - (n.v) n).
 """
 import numpy as np
 from numba import njit
@@ -22,15 +24,32 @@ def centroids(x, tris, out):
 
 
 @njit(cache=True)
-def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian):
+def normal_coefficient(sa, law, cn, kp, kv, sin_stall, c_stall):
+    """The normal force's coefficient c (kg/m^3) at an angle of attack of sine sa: the plate
+    law's cn (law 0) or the delta law's (law 1): kp cos^2 a + kv sin a cos a up to the stall
+    (kp, kv: 0.5 rho K_p and 0.5 rho K_v), above it the larger of c_stall / sin a (the
+    normal force held at its value at the stall, c_stall = 0.5 rho C_N there) and cn."""
+    if law == 0:
+        return cn
+    if sa <= sin_stall:
+        ca = np.sqrt(max(0.0, 1.0 - sa * sa))
+        return ca * (kp * ca + kv * sa)
+    return max(c_stall / sa, cn)
+
+
+@njit(cache=True)
+def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian, law=0, kp=0.0, kv=0.0,
+                    sin_stall=1.0, c_stall=0.0):
     """Add each triangle's force f/3 (N) to f (n,3) of its points; return the total force.
 
     wind (m,3): the wind velocity (m/s) at each centroid; cn (N s^2/m^4 per m^2 of area and
-    (m/s)^2: kg/m^3), ct (kg/(m^2 s)). With with_jacobian, dfdv (n,3,3) receives a symmetric
-    negative semidefinite d f / d v per point for implicit integrators: the triangle's
-    -(c_n s (|v| + |n.v|) n n^T + c_t s (I - n n^T)) (the symmetric part of the exact
-    derivative, exact when v is along n) lumped as 1/3 to each point (the row sum over the
-    three points sharing the triangle's velocity). The loop is serial: the scatter to shared
+    (m/s)^2: kg/m^3), ct (kg/(m^2 s)); law, kp, kv, sin_stall, c_stall: the normal force's
+    law (``normal_coefficient``; 0, the default, is SPEC 2.2's constant cn). With
+    with_jacobian, dfdv (n,3,3) receives a symmetric negative semidefinite d f / d v per
+    point for implicit integrators: the triangle's -(c s (|v| + |n.v|) n n^T + c_t s (I - n
+    n^T)) (the symmetric part of the exact derivative at the present coefficient c, exact for
+    the plate law when v is along n) lumped as 1/3 to each point (the row sum over the three
+    points sharing the triangle's velocity). The loop is serial: the scatter to shared
     points stays race-free, and a scene's aerodynamic meshes are small next to its springs.
     """
     total = np.zeros(3)
@@ -57,7 +76,9 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian):
         r2 = (v[i, 2] + v[j, 2] + v[k, 2]) / 3.0 - wind[t, 2]
         speed = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
         vn = n0 * r0 + n1 * r1 + n2 * r2
-        cnn = -cn * s * speed * vn
+        c = cn if law == 0 or speed == 0.0 else normal_coefficient(
+            abs(vn) / speed, law, cn, kp, kv, sin_stall, c_stall)
+        cnn = -c * s * speed * vn
         f0 = cnn * n0 - ct * s * (r0 - vn * n0)
         f1 = cnn * n1 - ct * s * (r1 - vn * n1)
         f2 = cnn * n2 - ct * s * (r2 - vn * n2)
@@ -69,7 +90,7 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian):
             f[p, 1] += f1 / 3.0
             f[p, 2] += f2 / 3.0
         if with_jacobian:
-            dn = cn * s * (speed + abs(vn))
+            dn = c * s * (speed + abs(vn))
             dt = ct * s
             nn = (n0, n1, n2)
             for p in (i, j, k):
