@@ -100,6 +100,31 @@ def test_the_panels_sew_into_closed_garments_of_the_stated_size(surface):
     assert net.m.sum() == pytest.approx(pants.area * G.FABRICS["fleece"].density, rel=1e-9)
 
 
+def test_the_stretch_certificate_counts_the_overstretched_share(surface):
+    """The pants dilated about their centre by 1 + e strain every structural spring by e
+    exactly (l = (1 + e) |x_i - x_j| against rest lengths cut at the same points, the
+    bands' shorter ones apart): at e = 3% the largest strain is 3% and no spring is past
+    OVERSTRETCH (5%), though the bands, cut short to grip, are; at e = 8% all are. The share
+    survives a checkpoint's capture and restore."""
+    from interplay.systems.garments import OVERSTRETCH
+    net = G.network(G.sweatpants(surface, G.Fit(spacing=0.03)))
+    x0 = net.x.copy()
+    c = x0.mean(axis=0)
+    for e, share in ((0.03, 0.0), (0.08, 1.0)):
+        net.x[:] = c + (1.0 + e) * (x0 - c)
+        largest, over = net.stretch()
+        assert largest["pants"] == pytest.approx(e, rel=1e-9)  # round-off of a length
+        assert largest["pants bands"] > OVERSTRETCH  # the bands are not in the share
+        assert over == {"pants": share}
+    net.certificates = [{"t": 0.0, "cloth_body_intersections": 0, "penetration_m": 0.0,
+                         "self_intersections": 0, "stretch": largest, "overstretched": over}]
+    snap = net.capture()
+    net.certificates = []
+    net.restore(snap)
+    assert net.certificates[0]["overstretched"] == {"pants": 1.0}
+    assert net.certificates[0]["stretch"] == largest
+
+
 def test_bad_garment_meshes_are_refused_naming_the_element(surface, tmp_path):
     x = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0, -1, 0]], float) * 0.01
     t = np.array([[0, 1, 2], [0, 1, 3], [0, 1, 4]])

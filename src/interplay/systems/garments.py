@@ -12,7 +12,10 @@ worn on (``watch``), at every output frame it measures, exactly:
 * self-intersections: pairs of the cloth's own triangles that interpenetrate, triangles
   sharing a vertex left out;
 * stretch: the largest strain (l / l0 - 1) of each garment's structural springs, its elastic
-  bands apart (they are cut to stretch).
+  bands apart (they are cut to stretch);
+* overstretched: the share of each garment's structural springs (bands apart) strained more
+  than ``OVERSTRETCH`` (5%, a cotton tee's limit in issue 16): the largest strain is one
+  spring's, this says whether it is a pinch or the garment.
 
 ``dress`` pulls a garment onto a body before t = 0: the skin moves from the A-pose the garment
 was cut in to the pose of the first frame while the cloth follows under its springs, gravity,
@@ -27,6 +30,8 @@ from ..errors import SceneError
 from ..geometry.aabb_tree import AABBTree
 from ..kernels.skin_contact import signed_distance, vertex_normals
 from .springmass import SpringNetwork, Springs
+
+OVERSTRETCH = 0.05  # strain past which a cotton knit is visibly overstretched (issue 16)
 
 
 class Garments(SpringNetwork):
@@ -110,19 +115,23 @@ class Garments(SpringNetwork):
         self._skin = skin
         self._body_tree = AABBTree(skin.now()[0], skin.tris, owner=f"{skin.figure.name} skin")
 
-    def stretch(self) -> dict:
-        """{part: largest structural strain}, elastic bands apart ("<part> bands")."""
+    def stretch(self) -> tuple[dict, dict]:
+        """({part: largest structural strain}, elastic bands apart as "<part> bands";
+        {part: share of its structural springs, bands apart, strained more than
+        OVERSTRETCH})."""
         d = np.linalg.norm(self.x[self.si] - self.x[self.sj], axis=1)
         strain = d / self.l0 - 1.0
-        out = {}
+        largest, share = {}, {}
         for name, idx in self.parts.items():
             on = np.zeros(len(self.x), bool)
             on[idx] = True
             mine = on[self.si] & (self.spring_kind == 0)
-            out[name] = float(strain[mine & ~self.band].max())
+            cloth = strain[mine & ~self.band]
+            largest[name] = float(cloth.max())
+            share[name] = float(np.mean(cloth > OVERSTRETCH))
             if (mine & self.band).any():
-                out[f"{name} bands"] = float(strain[mine & self.band].max())
-        return out
+                largest[f"{name} bands"] = float(strain[mine & self.band].max())
+        return largest, share
 
     def certify(self, t: float) -> dict:
         """The frame's certificates at time t (s) against the watched skin."""
@@ -141,9 +150,10 @@ class Garments(SpringNetwork):
         signed_distance(self.x, tri, bary, d, X, skin.tris, vn, s, n)
         depth = float(max(0.0, -s.min()))
         selfx = len(self._own.intersections())
+        largest, share = self.stretch()
         return {"t": float(t), "cloth_body_intersections": int(crossing),
                 "penetration_m": depth, "self_intersections": int(selfx),
-                "stretch": self.stretch()}
+                "stretch": largest, "overstretched": share}
 
     def frame(self):
         if self._skin is not None:
@@ -164,32 +174,43 @@ class Garments(SpringNetwork):
                 "penetration_max_m": max(f["penetration_m"] for f in c),
                 "self_intersections_max": max(f["self_intersections"] for f in c),
                 "stretch_max": {k: max(f["stretch"][k] for f in c) for k in c[0]["stretch"]},
+                "overstretched_max": {k: max(f["overstretched"][k] for f in c)
+                                      for k in c[0]["overstretched"]},
                 "per_frame": c}
         return out
 
     def capture(self):
         """The network's state and the certificates so far (one row per frame: t,
-        crossings, penetration, self-crossings, then each stretch key's value)."""
+        crossings, penetration, self-crossings, then each stretch key's value, then each
+        overstretched key's)."""
         snap = super().capture()
-        keys = sorted(self.certificates[0]["stretch"]) if self.certificates else []
+        c0 = self.certificates[0] if self.certificates else {"stretch": {}, "overstretched": {}}
+        keys, share = sorted(c0["stretch"]), sorted(c0["overstretched"])
         rows = [[c["t"], c["cloth_body_intersections"], c["penetration_m"],
-                 c["self_intersections"], *(c["stretch"][k] for k in keys)]
+                 c["self_intersections"], *(c["stretch"][k] for k in keys),
+                 *(c["overstretched"][k] for k in share)]
                 for c in self.certificates]
-        snap["cert"] = np.array(rows, float).reshape(len(rows), 4 + len(keys))
+        snap["cert"] = np.array(rows, float).reshape(len(rows), 4 + len(keys) + len(share))
         snap["cert_keys"] = np.array(keys, dtype=str)
+        snap["cert_share_keys"] = np.array(share, dtype=str)
         return snap
 
     def restore(self, snap):
         snap = dict(snap)
         rows, keys = snap.pop("cert", None), snap.pop("cert_keys", None)
+        share = snap.pop("cert_share_keys", None)
         super().restore(snap)
         if rows is not None:
             keys = [str(k) for k in np.asarray(keys).ravel()]
+            # a checkpoint written before the overstretched certificate has no share keys
+            share = [] if share is None else [str(k) for k in np.asarray(share).ravel()]
+            n = 4 + len(keys)
             self.certificates = [
                 {"t": float(r[0]), "cloth_body_intersections": int(r[1]),
                  "penetration_m": float(r[2]), "self_intersections": int(r[3]),
-                 "stretch": {k: float(v) for k, v in zip(keys, r[4:])}}
-                for r in np.asarray(rows, float).reshape(-1, 4 + len(keys))]
+                 "stretch": {k: float(v) for k, v in zip(keys, r[4:n])},
+                 "overstretched": {k: float(v) for k, v in zip(share, r[n:])}}
+                for r in np.asarray(rows, float).reshape(-1, n + len(share))]
 
 
 def _slerp(R0, R1, f):
