@@ -45,8 +45,9 @@ BOUNDS = {"prepare_at": (0.6, 2.0), "spot": (0.0, 0.2), "hip_prepare": (0.0, 1.2
 
 #: where the shipped controller's search starts (docs/mat.md): the best of the third search
 #: (``tune mat --budget 241 --chains 4 --seed 2`` from main's controller at 8de1dde, on the
-#: stand-in fitted to the viscous mat's statics and impactor drops); the search starts from
-#: the scene's parameters, so the command that made the defaults sets these (``start_sets``)
+#: stand-in fitted to main's coarse 31 x 17 x 4 viscous mat); the search that made the
+#: shipped defaults (search 5, on the stand-in refitted to the 46 x 37 x 4 mat) started here
+#: too. A search starts from the scene's parameters, so its command sets these (``start_sets``)
 START = {
     "prepare_at": 1.9704462292588398,
     "spot": 0.12645350690096074,
