@@ -101,13 +101,32 @@ def test_stiffness_proportional_damping_rate():
     assert rate == pytest.approx(beta * k / (2 * m), rel=1e-2)
 
 
-def _two_springs(kd, dt=1e-4, integrator="explicit"):
+def _two_springs(kd, dt=1e-4, integrator="explicit", **kw):
     """A free point between two fixed ones along x, the first spring with its own damping
     kd (N s/m), the second with none; no gravity."""
     x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
     springs = Springs.from_ratio(x, [(0, 1), (1, 2)], 50.0)  # k = 50 N/m each
     return SpringNetwork("two", x, [1.0, 0.5, 1.0], springs, dt=dt, integrator=integrator,
-                         spring_damping=[kd, 0.0], fixed=[0, 2], gravity=(0, 0, 0))
+                         spring_damping=[kd, 0.0], fixed=[0, 2], gravity=(0, 0, 0), **kw)
+
+
+def test_a_refused_step_advises_one_that_passes_every_criterion():
+    """The point between the springs: m = 0.5 kg, sum k = 100 N/m, c = kd / m = 40 1/s at
+    kd = 20 N s/m. The criteria in closed form: undamped h < sqrt(2 m / sum k) = 0.1 s,
+    damping h < 2 / c = 0.05 s, a share of 2.5: 200 h^2 + 80 h <= 2.5, h = 0.02913 s. Each
+    criterion refuses its own range and every message advises the smallest bound (rounded
+    down), at which the network builds: following the advice is never refused again."""
+    share = (np.sqrt(80.0 ** 2 + 4 * 200 * 2.5) - 80.0) / 400.0
+    net = _two_springs(20.0, dt=1e-3, stability_share=2.5)
+    b = net.explicit_bounds()
+    assert b["stiffness"] == pytest.approx(0.1, rel=1e-12)
+    assert b["damping"] == pytest.approx(0.05, rel=1e-12)
+    assert b["share"] == pytest.approx(share, rel=1e-12)
+    for dt, what in ((0.2, "explicit stability bound"), (0.06, "damping rate"),
+                     (0.03, "stability number")):
+        with pytest.raises(StabilityError, match=f"{what}.*use step < 0.0291 s, or less k"):
+            _two_springs(20.0, dt=dt, stability_share=2.5, dt_key="step", step_cure="less k")
+    _two_springs(20.0, dt=0.0291, stability_share=2.5)
 
 
 def test_a_springs_own_damping_rate():

@@ -198,7 +198,7 @@ def test_bad_bed_parameters_are_refused_with_one_line():
         T.bed(replace(BedParams(), spring_stiffness=-5.0))
     with pytest.raises(ParameterError, match="no mass for the bed"):
         build_bed(replace(BedParams(), spring_mass=1.0))
-    with pytest.raises(StabilityError, match="bed.dt <="):
+    with pytest.raises(StabilityError, match="use bed.dt < "):
         T.bed(replace(BedParams(), stiffness_damping=1e-3))
 
 

@@ -40,7 +40,7 @@ from ..systems.springmass import SpringNetwork, Springs
 from ..systems.static import StaticPlane
 from .contract import SceneSpec
 from .landing_measures import contrast, landing_figures
-from .trampoline import check_explicit
+from .trampoline import EXPLICIT_SHARE
 
 TABLE = (0.6, 0.475)  # m: the vault table's half length (x) and half width (y) (FIG: 1.2 x 0.95)
 SOLES = [SEGMENTS.index(s) for s in ("l_foot", "r_foot")]
@@ -82,10 +82,10 @@ def mat_network(p: MatParams, integrator: str = "implicit", dt: float | None = N
                         dt=dt or p.dt, integrator=integrator, mass_damping=p.mass_damping,
                         stiffness_damping=p.stiffness_damping, spring_damping=lat.kd,
                         triangles=lat.triangles,
-                        strain_limit=0.9, color=MAT_COLOR, fixed=lat.bottom)
-    if integrator == "explicit":
-        check_explicit(net, "mat.dt", "less mat.foam_damping, mat.brace_damping or "
-                       "mat.stiffness_damping")
+                        strain_limit=0.9, color=MAT_COLOR, fixed=lat.bottom,
+                        stability_share=EXPLICIT_SHARE, dt_key="mat.dt",
+                        step_cure="less mat.foam_damping, mat.brace_damping or "
+                        "mat.stiffness_damping")
     net.top, net.bottom, net.top_edges = lat.top, lat.bottom, lat.top_edges
     net.rest_height = p.thickness
     return net

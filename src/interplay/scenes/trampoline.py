@@ -42,7 +42,6 @@ from ..systems.static import StaticPlane
 from ..params import param
 from .contract import SceneSpec
 
-from ..errors import StabilityError, usable_below
 
 BED_COLOR = (0.05, 0.05, 0.06)  # the black webbing of a competition bed
 FRAME_COLOR = (0.1, 0.25, 0.6)  # painted steel (linear RGB)
@@ -72,6 +71,12 @@ class TrampolineParams:
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
 
 
+#: the share of symplectic Euler's stability limit, h^2 w^2 + 2 h c/m < 4, that the bed's own
+#: springs and damping may use; the rest is the sub-cycled contact's (w h = 1/3, critically
+#: damped: 1/9 + 4/3 of it)
+EXPLICIT_SHARE = 2.5
+
+
 def bed(p: BedParams, integrator: str = "explicit", dt: float | None = None) -> SpringNetwork:
     """The bed and its frame springs as one network (frame points fixed), settled under its
     own weight; the frame springs are drawn as cords. An explicit step past the bed's bound
@@ -87,43 +92,11 @@ def bed(p: BedParams, integrator: str = "explicit", dt: float | None = None) -> 
                         stiffness_damping=p.stiffness_damping, fixed=b.frame,
                         triangles=b.triangles, cords=b.frame_springs,
                         strain_limit=max(0.5, float(reach)),
-                        cord_radius=0.012, color=BED_COLOR)
-    if integrator == "explicit":
-        check_explicit(net)
+                        cord_radius=0.012, color=BED_COLOR, stability_share=EXPLICIT_SHARE,
+                        dt_key="bed.dt", step_cure="less stretch or stiffness_damping")
     net.bed_points, net.rest_height = b.bed_points, p.height
     net.settle(1.0)
     return net
-
-
-#: the share of symplectic Euler's stability limit, h^2 w^2 + 2 h c/m < 4, that the bed's own
-#: springs and damping may use; the rest is the sub-cycled contact's (w h = 1/3, critically
-#: damped: 1/9 + 4/3 of it)
-EXPLICIT_SHARE = 2.5
-
-
-def check_explicit(net: SpringNetwork, key: str = "bed.dt",
-                   cure: str = "less stretch or stiffness_damping"):
-    """Refuse an explicit step at which the bed's stiffest point is unstable: symplectic Euler
-    with damping, x'' + c x' + w^2 x = 0, is stable for h c < 2 and h^2 w^2 + 2 h c < 4, here
-    with w^2 = sum k / m and c = sum kd / m + alpha (net.damping_rates: beta sum k / m + alpha
-    when the springs have no damping of their own), the highest in-plane mode of a grid
-    point (its neighbours along one axis moving against it, the springs across it carrying
-    tension only); the contact needs the margin EXPLICIT_SHARE leaves."""
-    k = np.zeros(len(net.x))
-    np.add.at(k, net.si, net.k)
-    np.add.at(k, net.sj, net.k)
-    free = ~net.fixed
-    w2 = k[free] / net.m[free]
-    c = net.damping_rates()[free]
-    h = net.dt
-    worst = float(np.max(h * h * w2 + 2.0 * h * c))
-    if worst > EXPLICIT_SHARE:
-        # the largest h with h^2 w^2 + 2 h c = EXPLICIT_SHARE at every point
-        bound = float(np.min((np.sqrt(c * c + EXPLICIT_SHARE * w2) - c) / w2))
-        raise StabilityError(
-            f"{net.name}: dt={h:.3g} s is too large for its stiffness and damping (explicit "
-            f"stability number {worst:.2f}, at most {EXPLICIT_SHARE}); use {key} <= "
-            f"{usable_below(bound)} s, or {cure}")
 
 
 def pressed_points(net: SpringNetwork, half: float = 0.15) -> np.ndarray:

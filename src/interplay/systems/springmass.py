@@ -63,6 +63,10 @@ class SpringNetwork(System):
     at 8% of the median spring length); color: linear RGB (0..1) as drawn (None: the
     outputs' default); cords (c,2): point pairs drawn as cords beside a surface (a
     trampoline's frame springs), a shape of their own named "<name>-cords".
+    stability_share: with the explicit integrator, the share of damped symplectic Euler's
+    limit (h^2 w^2 + 2 h c < 4) the network may use, the rest left to what acts on it (a
+    sub-cycled contact); None: the undamped and damping bounds only (``explicit_bounds``);
+    dt_key, step_cure: how a refused step's message names the step and the other cures.
     """
 
     def __init__(self, name, positions, masses, springs: Springs, dt=1e-3, integrator="implicit",
@@ -71,7 +75,8 @@ class SpringNetwork(System):
                  gravity=GRAVITY, strain_limit=1.0, cg_tolerance=1e-8, cg_max_iter=400,
                  scheme="theta", theta=1.0, lg_iterations=10, lg_memory=3,
                  lg_tolerance=1e-4, lg_solver="auto", parallel=False, triangles=None,
-                 cord_radius=None, color=None, cords=None):
+                 cord_radius=None, color=None, cords=None, stability_share=None,
+                 dt_key="dt", step_cure="less stiffness or damping"):
         super().__init__(name, dt)
         x = np.array(positions, dtype=float)
         if x.ndim != 2 or x.shape[1] != 3 or len(x) == 0:
@@ -151,6 +156,9 @@ class SpringNetwork(System):
         self._pts = K.Points(self.x, self.v, self.m, self.fixed)
         self._load = K.Load(self.fext, self.kext, self.dext, self.kvref)
         self._view = None
+        self.stability_share = (None if stability_share is None else
+                                require_positive(name, "stability_share", stability_share))
+        self.dt_key, self.step_cure = dt_key, step_cure
         self.check_step(self.dt)
 
     def bundle(self, alpha=None) -> K.Network:
@@ -252,24 +260,57 @@ class SpringNetwork(System):
             return np.inf
         return float(np.min(np.sqrt(2.0 * self.m[free] / ksum[free])))
 
+    def explicit_bounds(self) -> dict:
+        """The largest explicit step (s) each criterion allows, at the stiffest free point:
+        "stiffness", h^2 sum k / m < 2 (``stable_step``: a chain's highest mode); with the
+        springs' own damping, "damping", h c < 2 (c = ``damping_rates``: a step taking more
+        than twice a point's velocity relative to its neighbours reverses and grows it); with
+        ``stability_share``, "share", h^2 w^2 + 2 h c <= stability_share (w^2 = sum k / m),
+        damped symplectic Euler's h^2 w^2 + 2 h c < 4 less what is left to others."""
+        out = {"stiffness": self.stable_step()}
+        c = self.damping_rates()[~self.fixed]
+        if np.any(self.kd > self.beta * self.k) and len(c) and c.max() > 0:
+            out["damping"] = 2.0 / float(c.max())
+        if self.stability_share is not None:
+            w2, c = self._share_rates()
+            if len(w2):
+                # the largest h with h^2 w^2 + 2 h c = share at every point
+                out["share"] = float(np.min(
+                    (np.sqrt(c ** 2 + self.stability_share * w2) - c) / w2))
+        return out
+
+    def _share_rates(self):
+        """(w^2 = sum k / m (1/s^2), c (1/s)) at the free points with springs."""
+        w2 = np.zeros(len(self.x))
+        np.add.at(w2, self.si, self.k)
+        np.add.at(w2, self.sj, self.k)
+        on = ~self.fixed & (w2 > 0)
+        return w2[on] / self.m[on], self.damping_rates()[on]
+
     def check_step(self, dt: float):
-        """Refuse an explicit step above the stability bound, naming the bound and the cure."""
-        if self.integrator == "explicit":
-            bound = self.stable_step()
-            if dt >= bound:
-                raise StabilityError(
-                    f"{self.name}: dt={dt:.3g} s is above the explicit stability bound "
-                    f"{bound:.4g} s; use dt <= {usable_below(bound)} or --integrator implicit")
-            # the springs' own damping can pass this bound where beta k could not (a scene's
-            # own check, as the trampoline's check_explicit, names its keys for beta)
-            own = bool(np.any(self.kd > self.beta * self.k))
-            c = self.damping_rates()[~self.fixed]
-            if own and len(c) and dt * c.max() >= 2.0:
-                raise StabilityError(
-                    f"{self.name}: dt={dt:.3g} s times the largest damping rate "
-                    f"{c.max():.3g} 1/s (sum of kd / m + alpha) is {dt * c.max():.2f}, at "
-                    f"least 2: unstable; use dt < {2.0 / c.max():.3g} s, less damping or "
-                    "--integrator implicit")
+        """Refuse an explicit step past any of ``explicit_bounds``, naming the criterion and
+        advising the largest step that passes them all (so following the advice is not
+        refused by the next criterion)."""
+        if self.integrator != "explicit":
+            return
+        b = self.explicit_bounds()
+        cure = (f"use {self.dt_key} < {usable_below(min(b.values()))} s, or "
+                f"{self.step_cure}, or --integrator implicit")
+        if dt >= b["stiffness"]:
+            raise StabilityError(f"{self.name}: dt={dt:.3g} s is above the explicit stability "
+                                 f"bound {b['stiffness']:.4g} s; {cure}")
+        if dt >= b.get("damping", np.inf):
+            c = 2.0 / b["damping"]
+            raise StabilityError(
+                f"{self.name}: dt={dt:.3g} s times the largest damping rate {c:.3g} 1/s "
+                f"(sum of kd / m + alpha) is {dt * c:.2f}, at least 2: unstable; {cure}")
+        if dt > b.get("share", np.inf):
+            w2, c = self._share_rates()
+            worst = float(np.max(dt * dt * w2 + 2.0 * dt * c))
+            raise StabilityError(
+                f"{self.name}: dt={dt:.3g} s is too large for its stiffness and damping "
+                f"(explicit stability number {worst:.2f}, at most {self.stability_share}); "
+                f"{cure}")
 
     # --- forces ----------------------------------------------------------------------------
     @property
