@@ -158,6 +158,21 @@ def test_a_vault_that_misses_the_mat_is_refused_in_one_line(capsys):
     assert len(err) == 1 and "misses the mat" in err[0]
 
 
+def test_a_hop_is_the_feet_rising_after_touch_down_above_where_they_stand():
+    """A lowest foot corner (100 Hz) sinking 6 cm into the mat at touch-down (0.5 s), rising
+    3 cm above its standing depth at 0.9-1.0 s and settling there: the hop is 3 cm, read
+    from 0.15 s after touch-down (the absorption's rebound of the mat before it is not a
+    hop); a landing that only sinks and settles has none."""
+    from interplay.scenes.landing_measures import hop
+    t = np.arange(251) / 100.0
+    low = np.where(t < 0.5, 1.0, -0.02)
+    low[(t >= 0.5) & (t < 0.65)] = -0.06
+    still = hop(t, low, 0.5)
+    low[(t >= 0.9) & (t <= 1.0)] = 0.01
+    assert still == 0.0
+    assert hop(t, low, 0.5) == pytest.approx(0.03, abs=1e-12)
+
+
 @pytest.fixture(scope="module")
 def default_run():
     return M.build("hybrid").simulate()

@@ -22,6 +22,7 @@ LOAD_WINDOW = 0.005  # s: the loading rate's rise is measured over this (a 1 ms 
 FEET = [SEGMENTS.index(s) for s in ("l_foot", "r_foot", "l_toes", "r_toes")]
 SOLES = [SEGMENTS.index(s) for s in ("l_foot", "r_foot")]
 STICK = {"speed": 0.15, "lead": 0.12, "tilt": 0.35, "moved": 0.05}  # m/s, m, rad, m
+HOP = 0.01  # m: feet rising more than this after touch-down left the mat (its rebound is mm)
 
 
 def _replica(meta):
@@ -137,6 +138,14 @@ def stuck(fr) -> dict:
     return out
 
 
+def hop(t, lowest, touch_down: float) -> float:
+    """(m) how high her feet's lowest corner rose, from 0.15 s after touch-down (s), above
+    where it is at the end (standing): she left the mat (a heel lifting alone leaves the
+    toes' corners down). The stick's measures are horizontal and do not see it."""
+    after = np.asarray(t) - touch_down >= 0.15
+    return float((lowest[after] - lowest[-1]).max()) if after.any() else 0.0
+
+
 def landing_figures(result) -> dict:
     """The scene's key figures (summary.json, compare's table)."""
     fr = result.frames.get("gymnast")
@@ -154,6 +163,10 @@ def landing_figures(result) -> dict:
         out["mat depression (m)"] = float(meta["mat_top"] - net["points"][:, top, 2].min())
         out["feet below the mat's top (m)"] = penetration(result)
     out.update(stuck(fr))
+    if "feet moved after touch-down (m)" in out:
+        lowest = feet_corners(result, fr["t"])[:, :, 2].min(axis=1)
+        out["feet's lowest corner rise after touch-down (m)"] = hop(
+            fr["t"], lowest, out["touch-down (s)"])
     out["warnings"] = []
     if out.get("feet below the mat's top (m)") is not None and \
             out["feet below the mat's top (m)"] > 0.01:
@@ -162,6 +175,11 @@ def landing_figures(result) -> dict:
             "into the mat (one-way replay: the mat cannot push back on recorded motion)")
     if "stuck" in out and not out["stuck"]:
         out["warnings"].append("she did not stick the landing (see the stick figures)")
+    rise = out.get("feet's lowest corner rise after touch-down (m)", 0.0)
+    if rise > HOP:
+        out["warnings"].append(f"she hopped: her feet left the mat by {rise:.3f} m after "
+                               "touch-down (not counted by 'stuck', whose measures are "
+                               "horizontal)")
     return out
 
 

@@ -294,6 +294,8 @@ class SpringNetwork(System):
         if self.integrator != "explicit":
             return
         b = self.explicit_bounds()
+        if dt < min(b.values()):
+            return
         cure = (f"use {self.dt_key} < {usable_below(min(b.values()))} s, or "
                 f"{self.step_cure}, or --integrator implicit")
         if dt >= b["stiffness"]:
