@@ -180,9 +180,18 @@ def default_run():
 
 @pytest.mark.slow
 def test_default_run_sticks_the_landing_and_depresses_the_mat(default_run):
+    # stuck: balanced (the horizontal measures) and no hop past 1 cm
     fig = M.landing_figures(default_run)
     assert fig["stuck"], fig
     assert 0.05 <= fig["mat depression (m)"] <= 0.2
+
+
+@pytest.mark.slow
+def test_the_controller_tuned_on_the_stand_in_sticks_on_the_two_way_mat():
+    """The paper's point: tuned on the stand-in alone, the controller lands on the full mat
+    (two-way, the mat's own step) and sticks there too, no hop, no step."""
+    fig = M.landing_figures(M.build("two-way").simulate())
+    assert fig["stuck"], fig
 
 
 class _Here:

@@ -7,7 +7,8 @@ for the air's drag). Peak force, and the loading rate as the steepest rise over 
 before the peak. The mat's depression is its top's lowest point below its rest height; the
 replay's penetration is how far the lowest corners of her feet went below the mat's
 deformed top surface (interpolated over its top points) at the output frames; the stick is
-read from the output frames (upright, still over the feet within 1 s, no step).
+read from the output frames (upright, still over the feet within 1 s, no step) and her
+feet's corners (no hop).
 """
 from __future__ import annotations
 
@@ -141,9 +142,25 @@ def stuck(fr) -> dict:
 def hop(t, lowest, touch_down: float) -> float:
     """(m) how high her feet's lowest corner rose, from 0.15 s after touch-down (s), above
     where it is at the end (standing): she left the mat (a heel lifting alone leaves the
-    toes' corners down). The stick's measures are horizontal and do not see it."""
+    toes' corners down). ``stuck``'s measures are horizontal and do not see it."""
     after = np.asarray(t) - touch_down >= 0.15
     return float((lowest[after] - lowest[-1]).max()) if after.any() else 0.0
+
+
+HOP_KEY = "feet's lowest corner rise after touch-down (m)"
+
+
+def stick(result) -> dict:
+    """``stuck``'s measures from her frames and the hop (``hop``, m); "balanced" is
+    ``stuck``'s verdict on the horizontal measures, "stuck" that and no hop past HOP."""
+    fr = result.frames["gymnast"]
+    out = stuck(fr)
+    if "feet moved after touch-down (m)" in out:
+        lowest = feet_corners(result, fr["t"])[:, :, 2].min(axis=1)
+        out[HOP_KEY] = hop(fr["t"], lowest, out["touch-down (s)"])
+        out["balanced"] = out["stuck"]
+        out["stuck"] = bool(out["balanced"] and out[HOP_KEY] <= HOP)
+    return out
 
 
 def landing_figures(result) -> dict:
@@ -162,11 +179,7 @@ def landing_figures(result) -> dict:
         top = np.arange(nx * ny) * nz + nz - 1
         out["mat depression (m)"] = float(meta["mat_top"] - net["points"][:, top, 2].min())
         out["feet below the mat's top (m)"] = penetration(result)
-    out.update(stuck(fr))
-    if "feet moved after touch-down (m)" in out:
-        lowest = feet_corners(result, fr["t"])[:, :, 2].min(axis=1)
-        out["feet's lowest corner rise after touch-down (m)"] = hop(
-            fr["t"], lowest, out["touch-down (s)"])
+    out.update(stick(result))
     out["warnings"] = []
     if out.get("feet below the mat's top (m)") is not None and \
             out["feet below the mat's top (m)"] > 0.01:
@@ -175,11 +188,9 @@ def landing_figures(result) -> dict:
             "into the mat (one-way replay: the mat cannot push back on recorded motion)")
     if "stuck" in out and not out["stuck"]:
         out["warnings"].append("she did not stick the landing (see the stick figures)")
-    rise = out.get("feet's lowest corner rise after touch-down (m)", 0.0)
-    if rise > HOP:
-        out["warnings"].append(f"she hopped: her feet left the mat by {rise:.3f} m after "
-                               "touch-down (not counted by 'stuck', whose measures are "
-                               "horizontal)")
+    if out.get("balanced") and out[HOP_KEY] > HOP:  # a fall is its own story
+        out["warnings"].append(f"she hopped: her feet left the mat by {out[HOP_KEY]:.3f} m "
+                               "after touch-down")
     return out
 
 
