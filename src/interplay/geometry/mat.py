@@ -114,7 +114,6 @@ class Lattice:
 #: the cells around it)
 BODY = 6
 _PER_CELL = np.array([1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 4.0])
-_NORMAL_FAMILY = {(True, False, False): 3, (False, True, False): 4, (False, False, True): 5}
 _PAIRS = ((0, 1), (0, 2), (1, 2))
 
 
@@ -262,11 +261,12 @@ def build_mat(p: MatParams) -> Lattice:
                 for s, t in zip(a, b):
                     key = (min(s, t), max(s, t))
                     faces[key] = faces.get(key, 0) + 1
-    fd = np.array(sorted(faces), np.int64)
-    plane = np.array([_NORMAL_FAMILY[tuple(np.abs(x[t] - x[s]) < 1e-12)] for s, t in fd])
+    keys = sorted(faces)
+    fd = np.array(keys, np.int64)
+    # a face diagonal's family is its face's normal: the one axis it does not cross
     pairs.append(fd)
-    kinds.append(plane)
-    shares.append(0.5 * np.array([faces[tuple(e)] for e in fd.tolist()], float))
+    kinds.append(3 + np.argmax(np.abs(x[fd[:, 1]] - x[fd[:, 0]]) < 1e-12, axis=1))
+    shares.append(0.5 * np.array([faces[e] for e in keys], float))
     bd = np.concatenate([np.stack([corner[(0, 0, 0)].ravel(), corner[(1, 1, 1)].ravel()], 1),
                          np.stack([corner[(1, 0, 0)].ravel(), corner[(0, 1, 1)].ravel()], 1),
                          np.stack([corner[(0, 1, 0)].ravel(), corner[(1, 0, 1)].ravel()], 1),

@@ -13,8 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import (ParameterError, SceneError, StabilityError, require_nonnegative,
-                      require_positive, usable_below)
+from ..errors import ParameterError, SceneError, require_nonnegative, require_positive
 from ..kernels import global_matrix as GM
 from ..kernels import localglobal as LG
 from ..kernels import multigrid as MG
@@ -24,6 +23,7 @@ from ..kernels.contact import colliders as no_colliders
 from ..kernels.part_contact import Parts
 from ..kernels.subcycle import advance_with_colliders, advance_with_parts
 from .base import GRAVITY, System, substeps
+from .explicit_stability import ExplicitStability
 from .shape import Shape, split_color
 from .spring_set import Springs  # noqa: F401 (networks are built from it: springmass.Springs)
 from .views import PointsView
@@ -37,7 +37,7 @@ LG_SOLVERS = ("auto", "direct", "multigrid")
 MULTIGRID_MIN_POINTS = 4000
 
 
-class SpringNetwork(System):
+class SpringNetwork(ExplicitStability, System):
     """A heterogeneous network of point masses and springs.
 
     positions: (n,3) m; masses: (n,) kg; springs: a ``Springs`` set;
@@ -238,81 +238,6 @@ class SpringNetwork(System):
                                  "explicit or implicit integrator (local/global damps with "
                                  "stiffness_damping alone)")
         return kd
-
-    # --- stability -------------------------------------------------------------------------
-    def damping_rates(self) -> np.ndarray:
-        """(n,) 1/s: each point's damping rate, sum of its springs' kd over its mass plus
-        alpha: an explicit step h must keep h times it under 2 (a step that takes away more
-        than twice a point's velocity relative to its neighbours reverses and grows it)."""
-        c = np.zeros(len(self.x))
-        np.add.at(c, self.si, self.kd)
-        np.add.at(c, self.sj, self.kd)
-        return c / self.m + self.alpha
-
-    def stable_step(self) -> float:
-        """Explicit (symplectic Euler) bound, dt < min_i sqrt(2 m_i / sum_j k_ij)  (s)."""
-        ksum = np.zeros(len(self.x))
-        np.add.at(ksum, self.si, self.k)
-        np.add.at(ksum, self.sj, self.k)
-        np.add.at(ksum, self.a_idx, self.a_k)
-        free = (ksum > 0) & ~self.fixed
-        if not np.any(free):
-            return np.inf
-        return float(np.min(np.sqrt(2.0 * self.m[free] / ksum[free])))
-
-    def explicit_bounds(self) -> dict:
-        """The largest explicit step (s) each criterion allows, at the stiffest free point:
-        "stiffness", h^2 sum k / m < 2 (``stable_step``: a chain's highest mode); with the
-        springs' own damping, "damping", h c < 2 (c = ``damping_rates``: a step taking more
-        than twice a point's velocity relative to its neighbours reverses and grows it); with
-        ``stability_share``, "share", h^2 w^2 + 2 h c <= stability_share (w^2 = sum k / m),
-        damped symplectic Euler's h^2 w^2 + 2 h c < 4 less what is left to others."""
-        out = {"stiffness": self.stable_step()}
-        c = self.damping_rates()[~self.fixed]
-        if np.any(self.kd > self.beta * self.k) and len(c) and c.max() > 0:
-            out["damping"] = 2.0 / float(c.max())
-        if self.stability_share is not None:
-            w2, c = self._share_rates()
-            if len(w2):
-                # the largest h with h^2 w^2 + 2 h c = share at every point
-                out["share"] = float(np.min(
-                    (np.sqrt(c ** 2 + self.stability_share * w2) - c) / w2))
-        return out
-
-    def _share_rates(self):
-        """(w^2 = sum k / m (1/s^2), c (1/s)) at the free points with springs."""
-        w2 = np.zeros(len(self.x))
-        np.add.at(w2, self.si, self.k)
-        np.add.at(w2, self.sj, self.k)
-        on = ~self.fixed & (w2 > 0)
-        return w2[on] / self.m[on], self.damping_rates()[on]
-
-    def check_step(self, dt: float):
-        """Refuse an explicit step past any of ``explicit_bounds``, naming the criterion and
-        advising the largest step that passes them all (so following the advice is not
-        refused by the next criterion)."""
-        if self.integrator != "explicit":
-            return
-        b = self.explicit_bounds()
-        if dt < min(b.values()):
-            return
-        cure = (f"use {self.dt_key} < {usable_below(min(b.values()))} s, or "
-                f"{self.step_cure}, or --integrator implicit")
-        if dt >= b["stiffness"]:
-            raise StabilityError(f"{self.name}: dt={dt:.3g} s is above the explicit stability "
-                                 f"bound {b['stiffness']:.4g} s; {cure}")
-        if dt >= b.get("damping", np.inf):
-            c = 2.0 / b["damping"]
-            raise StabilityError(
-                f"{self.name}: dt={dt:.3g} s times the largest damping rate {c:.3g} 1/s "
-                f"(sum of kd / m + alpha) is {dt * c:.2f}, at least 2: unstable; {cure}")
-        if dt > b.get("share", np.inf):
-            w2, c = self._share_rates()
-            worst = float(np.max(dt * dt * w2 + 2.0 * dt * c))
-            raise StabilityError(
-                f"{self.name}: dt={dt:.3g} s is too large for its stiffness and damping "
-                f"(explicit stability number {worst:.2f}, at most {self.stability_share}); "
-                f"{cure}")
 
     # --- forces ----------------------------------------------------------------------------
     @property
