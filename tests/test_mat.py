@@ -224,7 +224,7 @@ def test_tune_mat_keeps_or_improves_the_landing_and_its_files_run(tmp_path, monk
     from interplay.cli.controller import controller_sets
     from interplay.control import landing_search
     from interplay.control.landing_search import CLIP, LANDING
-    monkeypatch.setattr(landing_search, "TRIALS", ({},))
+    monkeypatch.setattr(landing_search, "TRIALS", ((0.0, 1.0),))
     base = RunRequest("mat", None, (), 1.9)
     doc = run_search(base, None, tmp_path, _Here(), budget=2, seed=3, chains=1,
                      log=lambda line: None)

@@ -11,16 +11,12 @@ off the support after it): each as a share of its threshold (clipped at CLIP, so
 counts as a fall however far she rolls), plus 1 while any horizontal one is past its
 threshold and 1 if she hopped. A stuck landing scores under 5; the lower, the more margin.
 
-Every candidate is flown from several take-offs (``TRIALS``: the vault as it is, 0.1 m/s
-to her left, and 1.6% more and less forward rotation) and scores their mean (the worst of
-them is a fall, flat, over most of the box, and gives an annealing nothing to follow). On the
-symmetric stand-in nothing ever pushes her sideways, so a search on the vault alone finds
-controllers with no sideways balance at all, which fall over sideways on the full mat, whose
-dent is never quite symmetric under two feet; and a controller searched without the pitch
-trials sticks the one vault it was searched on, falls from a take-off turning 0.05 rad/s
-faster, and fell forward on the two-way mat at every mat step finer than the default
-(measured: docs/mat.md). Robustness comes from the feedback the perturbations demand, still
-found on the stand-in alone.
+Every candidate is flown twice, the vault as it is and with a take-off PERTURB_VY m/s to her
+left, and scores the worse of the two: on the symmetric stand-in nothing ever pushes her
+sideways, so a search on the vault alone finds controllers with no sideways balance at all,
+which fall over sideways on the full mat, whose dent is never quite symmetric under two
+feet (measured: docs/mat.md). Robustness comes from the feedback the perturbation demands,
+still found on the stand-in alone.
 
 The search varies the landing controller only (``BOUNDS``: the prepare, absorption and hold
 postures and gains, the balance feedback), not the take-off, which is the vault's.
@@ -30,12 +26,11 @@ from __future__ import annotations
 from .search import Search
 
 CLIP = 10.0  # -: a measure past 10 times its threshold is a fall, whatever its size
-#: the take-offs every candidate flies, each a change of the vault's take-off (VaultParams
-#: fields: m/s, rad/s): as it is; 0.1 m/s to her left (8 cm of drift in flight); its forward
-#: rotation 0.05 rad/s (1.6%) faster and slower. The trials' mean loss is the candidate's.
-#: (A stand-in with a third of its damping, bouncier, was tried as a trial and left out:
-#: docs/mat.md)
-TRIALS = ({}, {"vy": 0.1}, {"spin": 0.05}, {"spin": -0.05})
+PERTURB_VY = 0.1  # m/s: the sideways take-off of the second trial (8 cm of drift in flight)
+#: the trials of every candidate: (sideways take-off added, m/s; the stand-in damping's share
+#: of its own). A third, (0, 1/3), a bouncier stand-in, was tried (docs/mat.md): its best came
+#: within 6% of two-way's peak force but 0.27 m off its path, so the defaults use these two
+TRIALS = ((0.0, 1.0), (PERTURB_VY, 1.0))
 
 #: the landing controller's parameters the search varies (VaultParams fields), (lo, hi) in
 #: their units; wide enough to hold every controller found by hand and by search so far
@@ -105,25 +100,25 @@ def stick_loss(figures: dict) -> float:
 def landing_loss(coupling: str, kw: dict) -> float:
     """The search's loss (module-level, so a worker can import it): the scene built with the
     keywords ``kw`` (params, duration, fps, ...) in ``coupling``, run (hybrid or one-way: the
-    primary pass only, her on the stand-in) from each of the TRIALS' take-offs; the mean
-    ``stick_loss``."""
+    primary pass only, her on the stand-in) as it is and with the take-off's sideways
+    velocity PERTURB_VY m/s more; the worse ``stick_loss`` of the two."""
     from dataclasses import replace
 
     from ..scenes.landing_measures import stick
     from ..scenes.mat import build
     p = kw["params"]
-    total = 0.0
-    for change in TRIALS:
-        vault = replace(p.vault, **{k: getattr(p.vault, k) + d for k, d in change.items()})
-        trial = dict(kw, params=replace(p, vault=vault))
+    worst = 0.0
+    for vy, damp in TRIALS:
+        q = replace(p, vault=replace(p.vault, vy=p.vault.vy + vy),
+                    standin=replace(p.standin, damping=p.standin.damping * damp))
+        trial = dict(kw, params=q)
         result = build(coupling, **trial).simulate(primary_only=coupling != "two-way")
-        total += stick_loss(stick(result))
-    return total / len(TRIALS)
+        worst = max(worst, stick_loss(stick(result)))
+    return worst
 
 
 LANDING = Search(
     "landing", "the landing controller on the stand-in: stuck (still, over the feet, upright, "
-               "no step, no hop), with margin, also off take-offs 0.1 m/s sideways and with "
-               "1.6% more and less rotation",
+               "no step, no hop), with margin, also off a take-off 0.1 m/s sideways",
     bounds={f"vault.{k}": v for k, v in BOUNDS.items()}, loss=landing_loss, budget=161,
     chains=4, t_start=2.0, t_end=0.02, step=0.12)
