@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from interplay.errors import ParameterError, StabilityError
+from interplay.errors import ParameterError, SceneError, StabilityError
 from interplay.systems.springmass import SpringNetwork, Springs
 
 
@@ -188,7 +188,7 @@ def test_chain_rests_on_the_elastic_catenary():
     m = np.full(N + 1, rho * L0 / N)
     m[[0, -1]] /= 2
     net = SpringNetwork("chain", x0, m, springs, integrator="implicit", dt=1e-3, fixed=[0, N])
-    net.settle(seconds=30.0, h=5e-3, damping=5.0)
+    net.settle()
     xc, zc = elastic_catenary(span, L0, rho * g, EA, s)
     sag = -zc.min()
     # lumping the weight at N nodes changes the shape by O((L0/N)^2 / L0^2) ~ 1e-3 of the sag
@@ -204,12 +204,46 @@ def test_a_remembered_sag_is_the_sag_of_that_network_only():
         sp = Springs.from_ratio(x0, [(i, i + 1) for i in range(10)], ea)
         net = SpringNetwork("chain", x0, np.full(11, 0.01), sp, integrator="implicit",
                             dt=1e-3, fixed=[0, 10])
-        net.settle(seconds=0.5, h=5e-3, damping=5.0)
+        net.settle()
         return net.x.copy()
     first, again, stiffer = chain(20.0), chain(20.0), chain(40.0)
     np.testing.assert_array_equal(first, again)
     # the softer chain sags further: by about twice as much for this elastic sag
     assert first[:, 2].min() < stiffer[:, 2].min() - 1e-3
+
+
+def test_the_settled_basketball_net_rests_where_a_long_relaxation_ends():
+    # settle is the minimum of the potential energy (Newton on the stiffness): at it every
+    # knot's springs balance its weight, and 20 s of heavily damped backward Euler (the
+    # slow reference: the net's slowest sag mode decays as exp(-omega^2 t / alpha)) ends
+    # there too. Tolerance: the relaxation's last residual force r over the cords' stiffness
+    # near the bottom (k ~ 10 N/m per cord at 0.2 g knots) is < 0.1 mm; 0.5 mm stated.
+    from interplay.scenes.basketball import BasketballParams, basketball_net
+    from interplay.systems.relaxation import relax
+
+    net = basketball_net(BasketballParams().net)
+    start = net.x.copy()
+    net.settle()
+    settled = net.x.copy()
+    weight = net.m.max() * 9.81
+    net.fext[:] = 0.0
+    assert np.abs(net.internal_forces()[~net.fixed]).max() < 1e-6 * weight
+    assert start[:, 2].min() - settled[:, 2].min() > 0.05  # it sags: ~13 cm at the bottom
+    net.x[:] = start
+    relax(net, 20.0, 5e-3, 5.0)
+    assert np.abs(net.x - settled).max() < 5e-4
+
+
+def test_a_point_on_no_taut_spring_has_no_rest():
+    # a free point joined by a slack cord only and to nothing below it falls for ever: the
+    # settle says which network and what to fix, rather than returning a shape mid-fall
+    x = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -0.5]])
+    sp = Springs(np.array([0]), np.array([1]), np.array([1.0]), np.array([10.0]),
+                 np.array([False]))
+    net = SpringNetwork("loose", x, np.array([0.1, 0.1]), sp, integrator="implicit", dt=1e-3,
+                        fixed=[])
+    with pytest.raises(SceneError, match="'loose'.*no rest under gravity.*anchor"):
+        net.settle()
 
 
 def test_explicit_step_above_bound_is_refused():

@@ -26,7 +26,7 @@ class DampingFieldParams:
     fitted to the default two-way basketball (``interplay fit-standin basketball``).
     """
     # fitted: `interplay fit-standin basketball` (docs/coupling.md)
-    linear: float = param(0.2062, "N s/m", ge=0.0, le=1e6, doc="per unit overlap")
+    linear: float = param(0.2342, "N s/m", ge=0.0, le=1e6, doc="per unit overlap")
     # the default ball enters without spin; a field cannot create spin
     angular: float = param(0.0, "N m s", ge=0.0, le=1e6, doc="per unit overlap")
     enabled: bool = True

@@ -140,7 +140,7 @@ def cord(c: CordParams, anchor, ankles, integrator="implicit", dt=None) -> Sprin
                         stiffness_damping=c.damping, fixed=[0, n, n + 1],
                         strain_limit=STRAIN_LIMIT, cord_radius=CORD_RADIUS,
                         color=(0.95, 0.75, 0.10))
-    net.settle(1.0)
+    net.settle()
     net.fixed[[n, n + 1]] = False  # the straps move with the ankles from here on
     return net
 

@@ -95,7 +95,7 @@ def bed(p: BedParams, integrator: str = "explicit", dt: float | None = None) -> 
                         cord_radius=0.012, color=BED_COLOR, stability_share=EXPLICIT_SHARE,
                         dt_key="bed.dt", step_cure="less stretch or stiffness_damping")
     net.bed_points, net.rest_height = b.bed_points, p.height
-    net.settle(1.0)
+    net.settle()
     return net
 
 

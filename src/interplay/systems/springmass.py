@@ -439,11 +439,11 @@ class SpringNetwork(ExplicitStability, System):
             self._return_impulses()
         self.time += h
 
-    def settle(self, seconds=1.0, h=2e-3, damping=30.0):
-        """Let the network sag to rest under gravity alone (``relaxation.settle``: implicit,
-        heavily damped, remembered per network for the process), v = 0 after."""
+    def settle(self):
+        """Let the network sag to rest under gravity alone (``relaxation.settle``: the minimum
+        of its potential energy, remembered per network for the process), v = 0 after."""
         from .relaxation import settle
-        settle(self, seconds, h, damping)
+        settle(self)
 
     # --- measures --------------------------------------------------------------------------
     def strain(self) -> float:
