@@ -19,7 +19,7 @@ from ..kernels import localglobal as LG
 from ..kernels import multigrid as MG
 from ..kernels import parallel as PAR
 from ..kernels import springs as K
-from ..kernels.contact import colliders as no_colliders
+from ..kernels.contact import THICKNESS, colliders as no_colliders
 from ..kernels.part_contact import Parts
 from ..kernels.subcycle import advance_with_colliders, advance_with_parts
 from .base import GRAVITY, System, substeps
@@ -131,6 +131,7 @@ class SpringNetwork(ExplicitStability, System):
         self._f = np.zeros_like(x)
         self._jac = False
         self._cols = None  # the colliders sub-cycled in the next advance, and their elements
+        self._free_dt = None  # (s, s): free_step and the dt it was found at
         self.cg_iterations = 0
         self.lg_iterations = int(require_positive(name, "lg_iterations", lg_iterations))
         self.lg_memory = int(require_nonnegative(name, "lg_memory", lg_memory))
@@ -303,6 +304,20 @@ class SpringNetwork(ExplicitStability, System):
         self._cols = (merged, old, parts)
         return True
 
+    def _within_reach(self, cols, h) -> bool:
+        """Whether any collider's path over the next h (s) can come within its reach (radius
+        plus the law's thickness) of the network's bounding box grown by the fastest point's
+        travel: a sphere stays within |v| h + |a| h^2 / 2 of where it starts."""
+        if not len(cols.radii):
+            return False
+        grow = float(np.sqrt((self.v * self.v).sum(axis=1).max())) * h
+        lo, hi = self.x.min(axis=0) - grow, self.x.max(axis=0) + grow
+        travel = (np.linalg.norm(cols.velocities, axis=1) * h
+                  + 0.5 * np.linalg.norm(cols.accels, axis=1) * h * h)
+        reach = (cols.radii + cols.law[:, THICKNESS] + travel)[:, None]
+        return bool(np.any(np.all((cols.centres + reach >= lo) & (cols.centres - reach <= hi),
+                                  axis=1)))
+
     def _return_impulses(self):
         """Hand each sub-cycled batch its own rows of the merged impulses."""
         cols, _, parts = self._cols
@@ -426,6 +441,17 @@ class SpringNetwork(ExplicitStability, System):
             if isinstance(cols, Parts):
                 advance_with_parts(self.bundle(), self._load, self._f, h, n, self._scheme(),
                                    self.has_prev, cols)
+            elif self.integrator == "explicit" and not self._within_reach(cols, h):
+                # nothing can touch the network this step: its own stable step, not the
+                # contact's (the basketball's net before the ball arrives and after it left)
+                cols.impulses[:] = 0.0
+                step = self.dt if dt is None else dt
+                if self._free_dt is None:
+                    self._free_dt = (self.free_step(), self.dt)
+                # a step the health check cut (dt / 10 on a rerun) cuts the free one alike
+                free, at = self._free_dt
+                m = substeps(h, max(step, free * self.dt / at))
+                self._explicit(h / m, m)
             else:
                 advance_with_colliders(self.bundle(), self._load, self._f, h, n,
                                        self._scheme(), self.has_prev, cols, elems)
