@@ -86,7 +86,10 @@ def advance_with_colliders(net, load, f, h, nsub, scheme, has_prev, cols, elems)
         _colliders_explicit(net, load, f, h, nsub, cols, elems)
 
 
-@njit(cache=True)
+# The kernels' shared pieces are inlined: a kernel called from another is compiled on its
+# own and then again inside its caller (Numba links the callee's code into the caller's and
+# optimises the whole), so a separate layer here doubled its compile (docs/first-run.md).
+@njit(cache=True, inline="always")
 def _collider_work(net, load, elems, cols, implicit):
     """The buffers of ``advance_with_colliders``: the contacts' entries (out), a collider's
     wrench, the substep's load, the free accelerations, and for the implicit solve its links
@@ -113,7 +116,7 @@ def _collider_work(net, load, elems, cols, implicit):
             np.empty((k_cols, 3)), np.empty((3, 3)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _collide(net, load, f, tau, dt, implicit, cols, elems, out, wrench, sub_load, acc, links,
              src, body_c, body_v, at, scratch):
     """One substep's forces at time tau (s) into the step: the network's own (into f), then
@@ -235,7 +238,7 @@ def advance_with_parts(net, load, f, h, nsub, scheme, has_prev, parts):
         _parts_explicit(net, load, f, h, nsub, parts)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _part_work(net, load, parts):
     """The buffers of ``advance_with_parts``: the contacts' entries, the touches, the parts'
     wrenches, the substep's load and the free accelerations."""
@@ -258,7 +261,7 @@ def _part_work(net, load, parts):
             np.empty_like(x))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _touch_parts(net, load, f, tau, dt, implicit, parts, out, tc, wrenches, sub_load, acc):
     """One substep's forces at time tau (s) into the step: the network's own (into f), then
     the parts' touches, scattered into f (explicit) or sub_load (implicit)."""
