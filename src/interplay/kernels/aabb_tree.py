@@ -62,7 +62,10 @@ def build(x, elems):
                 c = cen[order[i], r]
                 lo[r] = min(lo[r], c)
                 hi[r] = max(hi[r], c)
-        ax = int(np.argmax(hi - lo))
+        ax = 0  # the widest axis (a loop: array arithmetic compiles Numba's shape checks)
+        for r in range(1, 3):
+            if hi[r] - lo[r] > hi[ax] - lo[ax]:
+                ax = r
         keys = np.empty(t - s)
         for i in range(s, t):
             keys[i - s] = cen[order[i], ax]

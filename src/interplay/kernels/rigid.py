@@ -100,13 +100,25 @@ def rigid_step(body, wrench, h):
             a = (force[i] + own_mass * gravity[i]) / mass
             x[i] += h * v[i] + 0.5 * h * h * a
             v[i] += h * a
+    # I_w = R diag(I) R^T + carried, L = I_w w, dw = I_w^-1 (torque - w x L): written out
+    # for 3x3 (NumPy's matmul and LAPACK's solve cost Numba seconds to compile, for nothing)
     R = quat_to_matrix(q)
-    Iw = R @ np.diag(inertia_body) @ R.T + carried_inertia
-    L = Iw @ w
-    gyro = np.cross(w, L)
-    dw = np.linalg.solve(Iw, torque - gyro)
+    Iw = np.empty((3, 3))
     for i in range(3):
-        w[i] += h * dw[i]
+        for j in range(3):
+            Iw[i, j] = carried_inertia[i, j]
+            for k in range(3):
+                Iw[i, j] += R[i, k] * inertia_body[k] * R[j, k]
+    L = np.empty(3)
+    for i in range(3):
+        L[i] = Iw[i, 0] * w[0] + Iw[i, 1] * w[1] + Iw[i, 2] * w[2]
+    rhs = np.array([torque[0] - (w[1] * L[2] - w[2] * L[1]),
+                    torque[1] - (w[2] * L[0] - w[0] * L[2]),
+                    torque[2] - (w[0] * L[1] - w[1] * L[0])])
+    Iinv = np.empty((3, 3))
+    inv3(Iw, Iinv)
+    for i in range(3):
+        w[i] += h * (Iinv[i, 0] * rhs[0] + Iinv[i, 1] * rhs[1] + Iinv[i, 2] * rhs[2])
     ang = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * h
     if ang > 0.0:
         s = np.sin(0.5 * ang) / (ang / h)
@@ -135,8 +147,8 @@ def generalized(x, v, q, w, gx, gv):
 def kinetic_energy(v, q, w, mass, inertia_body):
     """Translational plus rotational kinetic energy (J)."""
     R = quat_to_matrix(q)
-    wb = R.T @ w
     e = 0.0
     for i in range(3):
-        e += 0.5 * mass * v[i] * v[i] + 0.5 * inertia_body[i] * wb[i] * wb[i]
+        wb = R[0, i] * w[0] + R[1, i] * w[1] + R[2, i] * w[2]  # (R^T w)_i, the body frame's
+        e += 0.5 * mass * v[i] * v[i] + 0.5 * inertia_body[i] * wb * wb
     return e
