@@ -465,11 +465,12 @@ class SpringNetwork(ExplicitStability, System):
             self._return_impulses()
         self.time += h
 
-    def settle(self):
+    def settle(self, relaxed: float | None = None):
         """Let the network sag to rest under gravity alone (``relaxation.settle``: the minimum
-        of its potential energy, remembered per network for the process), v = 0 after."""
+        of its potential energy, or ``relaxed`` s of damped relaxation; remembered per network
+        for the process), v = 0 after."""
         from .relaxation import settle
-        settle(self)
+        settle(self, relaxed)
 
     # --- measures --------------------------------------------------------------------------
     def strain(self) -> float:
