@@ -334,11 +334,17 @@ def add_solids(solids, grid, ns, lids, n, owner0):
 
 @njit(cache=True)
 def group_lids(lids, n):
-    """Sort the first n lids by column (stable: lids of one column keep their order)."""
+    """Sort the first n lids by column (stable: lids of one column keep their order).
+    Gathered by a loop, not NumPy's fancy indexing, which costs Numba seconds to compile for
+    each array type (7.5 s against 2.6 s for this kernel on an empty cache)."""
     order = np.argsort(lids.cell[:n], kind="mergesort")
-    for arr in (lids.cell, lids.owner):
-        arr[:n] = arr[:n][order]
-    for arr in (lids.scale, lids.vz):
-        arr[:n] = arr[:n][order]
-    lids.zlo[:n] = lids.zlo[:n][order]
-    lids.zhi[:n] = lids.zhi[:n][order]
+    cell, owner = lids.cell[:n].copy(), lids.owner[:n].copy()
+    scale, vz = lids.scale[:n].copy(), lids.vz[:n].copy()
+    zlo, zhi = lids.zlo[:n].copy(), lids.zhi[:n].copy()
+    for m in range(n):
+        o = order[m]
+        lids.cell[m], lids.owner[m] = cell[o], owner[o]
+        lids.scale[m], lids.vz[m] = scale[o], vz[o]
+        for s in range(zlo.shape[1]):
+            lids.zlo[m, s] = zlo[o, s]
+            lids.zhi[m, s] = zhi[o, s]
