@@ -57,9 +57,7 @@ class ExplicitStability:
         if self.stability_share is not None:
             w2, c = self._share_rates()
             if len(w2):
-                # the largest h with h^2 w^2 + 2 h c = share at every point
-                out["share"] = float(np.min(
-                    (np.sqrt(c ** 2 + self.stability_share * w2) - c) / w2))
+                out["share"] = _largest_step(self.stability_share, w2, c)
         return out
 
     def free_step(self) -> float:
@@ -75,8 +73,7 @@ class ExplicitStability:
         on = ~self.fixed & (w2 > 0)
         if not np.any(on):
             return np.inf
-        w2, c = w2[on] / self.m[on], self.damping_rates()[on]
-        return float(np.min((np.sqrt(c ** 2 + FREE_SHARE * w2) - c) / w2))
+        return _largest_step(FREE_SHARE, w2[on] / self.m[on], self.damping_rates()[on])
 
     def _share_rates(self):
         """(w^2 = sum k / m (1/s^2), c (1/s)) at the free points with springs."""
@@ -110,3 +107,8 @@ class ExplicitStability:
                 f"{self.name}: dt={dt:.3g} s is too large for its stiffness and damping "
                 f"(explicit stability number {worst:.2f}, at most {self.stability_share}); "
                 f"{cure}")
+
+
+def _largest_step(share, w2, c) -> float:
+    """(s) The largest h with h^2 w^2 + 2 h c <= share at every point (w2 1/s^2, c 1/s)."""
+    return float(np.min((np.sqrt(c ** 2 + share * w2) - c) / w2))
