@@ -20,6 +20,13 @@ The state machine (control/fsm.py), in the paper's style:
 * ``hold``: arms out to the sides, knees soft, the ankles balancing the centre of mass over
   the feet (the figure's ankle strategy and ``LandingBalance``): she stands, no step.
 
+On the ground, from touch-down on, ``LandingBalance`` also feeds back the capture point
+xi = (c - s) + v / w0 along her heading (c - s the centre of mass's lead over the middle of
+the soles, v its speed, w0 = sqrt(g / h) for its height h over them: where an inverted
+pendulum would come to rest): the hips flex by ``cp_hip`` xi (a bend at the hips pushes the
+ground backwards under the feet, braking a centre of mass headed past the toes), the ankles
+plantarflex by ``cp_ankle`` xi and the knees extend by ``cp_knee`` xi (rad/m each).
+
 Angles in rad (anatomical sense: flexion positive; ankle flexion is dorsiflexion), times in
 s.
 """
@@ -60,7 +67,8 @@ class VaultParams:
     feet and its speed); k_side (rad/m), k_side_drift (rad s/m): the hip strategy sideways on
     the ground (the hips ab/adducted together, shifting the pelvis over the feet against the
     centre of mass's sideways lead over the middle of the soles and its sideways speed); vy
-    (m/s): a sideways take-off velocity (0 in the vault; the landing search perturbs it)."""
+    (m/s): a sideways take-off velocity (0 in the vault; the landing search perturbs it);
+    cp_hip, cp_ankle, cp_knee (rad/m): the capture-point feedback (module docstring)."""
     mass: float = param(64.38, "kg", ge=10.0, le=500.0)
     height: float = param(1.70, "m", ge=0.5, le=3.0)
     table: float = param(1.25, "m", ge=0.0, le=5.0, doc="vault table height")
@@ -70,30 +78,36 @@ class VaultParams:
     vy: float = param(0.0, "m/s", ge=-5.0, le=5.0, doc="sideways take-off velocity (left +)")
     pitch0: float = param(3.45, "rad", ge=-7.0, le=7.0, doc="trunk's turn from upright")
     spin: float = param(3.0505318143348936, "rad/s", ge=-30.0, le=30.0, doc="forward rotation")
-    prepare_at: float = param(2.0, "rad", ge=0.0, le=3.2)
-    spot: float = param(0.10252269920067038, "s", ge=0.0, le=2.0)
-    hip_prepare: float = param(0.06261879805849256, "rad", ge=-0.5, le=2.5)
-    knee_prepare: float = param(0.31310659863954104, "rad", ge=0.0, le=2.5)
-    ankle_prepare: float = param(-0.597959138322305, "rad", ge=-1.0, le=1.0, doc="toes first")
+    prepare_at: float = param(1.9999785815096467, "rad", ge=0.0, le=3.2)
+    spot: float = param(0.08817041608052571, "s", ge=0.0, le=2.0)
+    hip_prepare: float = param(0.21531774614441215, "rad", ge=-0.5, le=2.5)
+    knee_prepare: float = param(0.5961769965268522, "rad", ge=0.0, le=2.5)
+    ankle_prepare: float = param(-0.584857642005506, "rad", ge=-1.0, le=1.0, doc="toes first")
     arms_prepare: float = param(3.1, "rad", ge=-1.0, le=3.2)
-    hip_absorb: float = param(1.1300424063929904, "rad", ge=0.0, le=2.5)
-    knee_absorb: float = param(1.6229878374547106, "rad", ge=0.0, le=2.5)
-    ankle_absorb: float = param(0.44345747335703045, "rad", ge=-0.5, le=1.0)
-    absorb_omega: float = param(9.280780539647017, "rad/s", gt=0.0, le=100.0)
-    absorb_zeta: float = param(0.2832045850173293, "-", gt=0.0, le=10.0, doc="absorption damping")
-    absorb: float = param(0.2, "s", ge=0.0, le=5.0)
+    hip_absorb: float = param(1.3455092863731835, "rad", ge=0.0, le=2.5)
+    knee_absorb: float = param(1.7969984600776958, "rad", ge=0.0, le=2.5)
+    ankle_absorb: float = param(0.6042330290045362, "rad", ge=-0.5, le=1.0)
+    absorb_omega: float = param(6.669177832987387, "rad/s", gt=0.0, le=100.0)
+    absorb_zeta: float = param(0.23471604591450732, "-", gt=0.0, le=10.0, doc="absorption damping")
+    absorb: float = param(0.3522934567534239, "s", ge=0.0, le=5.0)
     arms_out: float = param(1.4, "rad", ge=0.0, le=3.2)
-    knee_hold: float = param(0.5080116674579409, "rad", ge=0.0, le=2.5)
-    k_lead: float = param(0.3103154414611504, "rad/m", ge=0.0, le=50.0)
-    k_drift: float = param(0.0, "rad s/m", ge=0.0, le=20.0)
-    k_spin: float = param(0.0028589731338881153, "rad s/(kg m^2)", ge=0.0, le=1.0)
-    k_attitude: float = param(0.08406849961125219, "-", ge=0.0, le=3.0)
-    k_hip_spin: float = param(-0.051854380011055586, "rad s/(kg m^2)", ge=-1.0, le=1.0)
-    hold_lead: float = param(0.7339484724360303, "rad/m", ge=0.0, le=20.0, doc="hold: on the lead")
-    hold_drift: float = param(0.5046230030612927, "rad s/m", ge=0.0, le=20.0, doc="hold: on speed")
-    k_side: float = param(0.34116493198332043, "rad/m", ge=-20.0, le=20.0, doc="sideways hips")
-    k_side_drift: float = param(0.024566464855095123, "rad s/m", ge=-20.0, le=20.0, doc="on speed")
-    k_speed: float = param(0.04087011241322212, "s", ge=0.0, le=5.0)
+    knee_hold: float = param(0.3550437942934214, "rad", ge=0.0, le=2.5)
+    k_lead: float = param(0.9249447025596899, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.15835265856750294, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.015710509101857006, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.1719841251927221, "-", ge=0.0, le=3.0)
+    k_hip_spin: float = param(-0.02204344741984415, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    hold_lead: float = param(0.0, "rad/m", ge=0.0, le=20.0, doc="hold: on the lead")
+    hold_drift: float = param(0.7014320954254105, "rad s/m", ge=0.0, le=20.0, doc="hold: on speed")
+    k_side: float = param(2.1081609100419727, "rad/m", ge=-20.0, le=20.0, doc="sideways hips")
+    k_side_drift: float = param(2.030308304523256, "rad s/m", ge=-20.0, le=20.0, doc="on speed")
+    k_speed: float = param(0.15368094443946154, "s", ge=0.0, le=5.0)
+    cp_hip: float = param(1.4981901337015116, "rad/m", ge=-20.0, le=20.0,
+                           doc="hips on xi")
+    cp_ankle: float = param(1.2419719870294006, "rad/m", ge=-20.0, le=20.0,
+                           doc="ankles on xi")
+    cp_knee: float = param(-0.9264380252337816, "rad/m", ge=-20.0, le=20.0,
+                           doc="knees on xi")
 
 
 def controller(p: VaultParams) -> Controller:
@@ -127,6 +141,9 @@ def controller(p: VaultParams) -> Controller:
 
 SIDE_MAX = 0.3  # rad: the largest sideways hip offset
 SIDE_RATE = 3.0  # rad/s: its fastest change (a shift, not a kick)
+CP_MAX = 0.6  # rad: the largest capture-point offset of a joint
+CP_RATE = 6.0  # rad/s: its fastest change
+G = 9.81  # m/s^2
 
 
 class LandingBalance(BounceBalance):
@@ -134,8 +151,9 @@ class LandingBalance(BounceBalance):
     reused): in the air, from ``prepare`` on, the feet are placed ahead of the centre of mass
     by k_speed times its speed; on the ground the ankles steer the centre of mass over the feet
     and the hips hold the pelvis upright over the legs, and (its own) shift it sideways over
-    the feet (k_side, k_side_drift). Nothing while she turns over in ``flight`` (the
-    placement's angles mean nothing upside down)."""
+    the feet (k_side, k_side_drift) and answer the capture point (cp_hip, cp_ankle,
+    cp_knee). Nothing while she turns over in ``flight`` (the placement's angles mean nothing
+    upside down)."""
 
     def __init__(self, p: VaultParams, joints):
         bp = BounceParams(k_speed=p.k_speed, k_place=0.0, k_lead=p.k_lead, k_drift=p.k_drift,
@@ -144,14 +162,18 @@ class LandingBalance(BounceBalance):
         super().__init__(bp, joints)
         self.k_side, self.k_side_drift = p.k_side, p.k_side_drift
         self.side = 0.0  # rad: the sideways hip offset now
+        self.cp_gain = np.array([p.cp_hip, -p.cp_ankle, -p.cp_knee])
+        self.cp = np.zeros(3)  # rad: the capture point's hip, ankle and knee offsets now
+        self.knees = np.array([joints.index("l_knee"), joints.index("r_knee")])
 
     def capture(self) -> dict:
-        return dict(super().capture(), side=np.array(self.side))
+        return dict(super().capture(), side=np.array(self.side), cp=self.cp.copy())
 
     def restore(self, snap: dict):
         super().restore(snap)
         if snap:
             self.side = float(snap["side"])
+            self.cp[:] = snap["cp"]
 
     def offsets(self, fig, sensors) -> np.ndarray:
         if fig.fsm.state.name == "flight":
@@ -160,18 +182,30 @@ class LandingBalance(BounceBalance):
         # sideways, on the ground: a symmetric stand-in never pushes her sideways, a mat's
         # dent and a crooked take-off do; the hips shift the pelvis over the feet
         want = 0.0
+        cp = np.zeros(3)
         if len(fig.feet_touching()):
             d = fig.data
-            _, left = fig.heading_axes()
-            lead = (sensors["com"] - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ left
+            fwd, left = fig.heading_axes()
+            rel = sensors["com"] - d.geom_xpos[fig.sole_geoms].mean(axis=0)
+            lead = rel @ left
             want = float(np.clip(self.k_side * lead + self.k_side_drift * (sensors["com_vel"]
                                                                            @ left),
                                  -SIDE_MAX, SIDE_MAX))
+            # the capture point: where over the ground the centre of mass, an inverted
+            # pendulum of its height over the soles, would come to rest
+            w0 = math.sqrt(G / max(rel[2], 0.3))
+            xi = rel @ fwd + (sensors["com_vel"] @ fwd) / w0
+            cp = np.clip(self.cp_gain * xi, -CP_MAX, CP_MAX)
         step = SIDE_RATE * fig.control_dt
         self.side = float(np.clip(want, self.side - step, self.side + step))
+        self.cp = np.clip(cp, self.cp - CP_RATE * fig.control_dt,
+                          self.cp + CP_RATE * fig.control_dt)
         res = out.copy()
         res[self.abd_l] += self.side
         res[self.abd_r] -= self.side
+        res[self.flex] += self.cp[0]
+        res[self.ankles] += self.cp[1]
+        res[self.knees] += self.cp[2]
         return res
 
 
