@@ -102,12 +102,9 @@ class VaultParams:
     k_side: float = param(0.34116493198332043, "rad/m", ge=-20.0, le=20.0, doc="sideways hips")
     k_side_drift: float = param(0.024566464855095123, "rad s/m", ge=-20.0, le=20.0, doc="on speed")
     k_speed: float = param(0.04087011241322212, "s", ge=0.0, le=5.0)
-    cp_hip: float = param(0.0, "rad/m", ge=-20.0, le=20.0,
-                           doc="hips on xi")
-    cp_ankle: float = param(0.0, "rad/m", ge=-20.0, le=20.0,
-                           doc="ankles on xi")
-    cp_knee: float = param(0.0, "rad/m", ge=-20.0, le=20.0,
-                           doc="knees on xi")
+    cp_hip: float = param(0.0, "rad/m", ge=-20.0, le=20.0, doc="hips on xi")
+    cp_ankle: float = param(0.0, "rad/m", ge=-20.0, le=20.0, doc="ankles on xi")
+    cp_knee: float = param(0.0, "rad/m", ge=-20.0, le=20.0, doc="knees on xi")
 
 
 def controller(p: VaultParams) -> Controller:
