@@ -39,6 +39,7 @@ import numpy as np
 
 from ..geometry.anthropometry import BodyParams
 from ..params import param
+from ..systems.base import GRAVITY
 from ..systems.figure import Figure, FigureParams
 from ..systems.figure_model import EnvironmentParams
 from .bounce import BounceBalance, BounceParams
@@ -140,7 +141,6 @@ SIDE_MAX = 0.3  # rad: the largest sideways hip offset
 SIDE_RATE = 3.0  # rad/s: its fastest change (a shift, not a kick)
 CP_MAX = 0.6  # rad: the largest capture-point offset of a joint
 CP_RATE = 6.0  # rad/s: its fastest change
-G = 9.81  # m/s^2
 
 
 class LandingBalance(BounceBalance):
@@ -190,7 +190,7 @@ class LandingBalance(BounceBalance):
                                  -SIDE_MAX, SIDE_MAX))
             # the capture point: where over the ground the centre of mass, an inverted
             # pendulum of its height over the soles, would come to rest
-            w0 = math.sqrt(G / max(rel[2], 0.3))
+            w0 = math.sqrt(-GRAVITY[2] / max(rel[2], 0.3))
             xi = rel @ fwd + (sensors["com_vel"] @ fwd) / w0
             cp = np.clip(self.cp_gain * xi, -CP_MAX, CP_MAX)
         step = SIDE_RATE * fig.control_dt
