@@ -229,7 +229,8 @@ def overlap_pairs(ta, tb, self_tree, out):
             continue
         if top + 4 > st.shape[0]:
             grown = np.empty((2 * st.shape[0], 2), np.int64)
-            grown[:top] = st[:top]
+            for r in range(top):
+                grown[r, 0], grown[r, 1] = st[r, 0], st[r, 1]
             st = grown
         # descend the interior node with the larger box (both when it is the same node)
         if self_tree and a == b:

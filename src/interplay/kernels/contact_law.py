@@ -96,7 +96,8 @@ def sticking_friction(n, vt, fn, cs, cd, mu, eps, meff, dt, stretch, out_ft):
     if gn <= cap:
         for a in range(3):
             out_ft[a] = -g[a]
-        stretch[:] = u
+        for a in range(3):
+            stretch[a] = u[a]
         return cs, cd
     # slipping: Coulomb at the cone, opposing the spring and the slip; below eps the spring,
     # saturated here, takes the place of the regularised law's viscous range
@@ -106,7 +107,8 @@ def sticking_friction(n, vt, fn, cs, cd, mu, eps, meff, dt, stretch, out_ft):
     if vtn < eps:
         visc = min(cap / eps, meff / dt) if dt > 0.0 else cap / eps
     if cs > 0.0:
-        stretch[:] = g * (cap / (gn * cs))  # the spring at its limit
+        for a in range(3):
+            stretch[a] = g[a] * (cap / (gn * cs))  # the spring at its limit
     else:
         stretch[:] = 0.0
     return 0.0, visc

@@ -92,7 +92,9 @@ def apply_inverse(pre, q, z):
     levels, else the factored solve; z is scratch."""
     if pre.mg.sizes.shape[0] > 0:
         vcycle(pre.mg, pre.work, q, z)
-        q[:] = z
+        for i in range(q.shape[0]):
+            for r in range(3):
+                q[i, r] = z[i, r]
     else:
         ldl_solve(pre.direct, q, z, q)
 

@@ -62,6 +62,29 @@ class Load(NamedTuple):
     kvref: np.ndarray
 
 
+# Copies are loops, not slice assignments: an array assigned into a slice makes Numba compile
+# its shape-mismatch error message (string formatting) into the kernel, 1-2 s of a first run
+# for a message no correct call can raise (docs/first-run.md).
+@njit(cache=True, inline="always")
+def copy_rows(src, dst):
+    """dst[i, r] = src[i, r] for every point i of (n,3) arrays."""
+    for i in range(src.shape[0]):
+        for r in range(3):
+            dst[i, r] = src[i, r]
+
+
+@njit(cache=True, inline="always")
+def copy_load(src, dst):
+    """Every array of the Load ``src`` into the Load ``dst`` of the same shapes."""
+    copy_rows(src.f, dst.f)
+    copy_rows(src.kvref, dst.kvref)
+    for i in range(src.kext.shape[0]):
+        for a in range(3):
+            for b in range(3):
+                dst.kext[i, a, b] = src.kext[i, a, b]
+                dst.dext[i, a, b] = src.dext[i, a, b]
+
+
 class Scheme(NamedTuple):
     """How a network steps: implicit (else symplectic Euler); theta (the theta-method's
     weight) or bdf2; tol and max_iter of the CG solve; xp, vp (n,3) the previous step's state
@@ -333,7 +356,8 @@ def implicit_step_with_bodies(net, load, f, h, scheme, has_prev, bodies):
     nb = bodies.mass.shape[0]
     big = n + nb  # unknowns: the points' velocity changes, then the coupled free bodies'
     fixed_all = np.ones(big, np.bool_)  # a body's row is solved only while it touches
-    fixed_all[:n] = fixed
+    for i in range(n):
+        fixed_all[i] = fixed[i]
     nl = bodies.count
     links = np.full((nl, 2), -1, np.int64)  # (point, body row) of each coupling
     coupled = False

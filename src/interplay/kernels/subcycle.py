@@ -21,8 +21,8 @@ from numba import njit
 
 from .contact import Sphere, sphere_elements, THICKNESS
 from .part_contact import Touches, find_touches, touch_forces
-from .springs import (Bodies, Load, PointForces, implicit_step, implicit_step_with_bodies,
-                      network_forces, symplectic_update)
+from .springs import (Bodies, Load, PointForces, copy_load, copy_rows, implicit_step,
+                      implicit_step_with_bodies, network_forces, symplectic_update)
 
 
 @njit(cache=True)
@@ -127,17 +127,15 @@ def _collide(net, load, f, tau, dt, implicit, cols, elems, out, wrench, sub_load
     n = x.shape[0]
     network_forces(net, load.f, f)
     lo, hi, c = scratch[0], scratch[1], scratch[2]
-    lo[:] = x[0]
-    hi[:] = x[0]
+    for r in range(3):
+        lo[r] = x[0, r]
+        hi[r] = x[0, r]
     for i in range(1, n):
         for r in range(3):
             lo[r] = min(lo[r], x[i, r])
             hi[r] = max(hi[r], x[i, r])
     if implicit:
-        sub_load.f[:] = load.f
-        sub_load.kext[:] = load.kext
-        sub_load.dext[:] = load.dext
-        sub_load.kvref[:] = load.kvref
+        copy_load(load, sub_load)
     impulses = cols.impulses
     have_acc = False
     count = 0
@@ -176,10 +174,12 @@ def _collide(net, load, f, tau, dt, implicit, cols, elems, out, wrench, sub_load
         _scatter(out, cnt, f, sub_load, implicit)
         for e in range(cnt if implicit else 0):
             links.idx[count] = out.idx[e]
-            links.f[count] = out.f[e]
-            links.dfdx[count] = out.dfdx[e]
-            links.dfdv[count] = out.dfdv[e]
-            links.vref[count] = out.vref[e]
+            for a in range(3):
+                links.f[count, a] = out.f[e, a]
+                links.vref[count, a] = out.vref[e, a]
+                for b in range(3):
+                    links.dfdx[count, a, b] = out.dfdx[e, a, b]
+                    links.dfdv[count, a, b] = out.dfdv[e, a, b]
             src[count] = q
             count += 1
     return count
@@ -213,7 +213,7 @@ def _colliders_implicit(net, load, f, h, nsub, scheme, has_prev, cols, elems):
     for step in range(nsub):
         count = _collide(net, load, f, step * dt, dt, True, cols, elems, out, wrench, sub_load,
                          acc, links, src, body_c, body_v, at, scratch)
-        x0[:] = x
+        copy_rows(x, x0)
         implicit_step_with_bodies(net, sub_load, f, dt, scheme, has_prev or step > 0,
                                   Bodies(cols.masses, body_v, cols.accels, src, links,
                                          count, body_dv, flin))
@@ -273,10 +273,7 @@ def _touch_parts(net, load, f, tau, dt, implicit, parts, out, tc, wrenches, sub_
     impulses = parts.impulses
     network_forces(net, load.f, f)
     if implicit:
-        sub_load.f[:] = load.f
-        sub_load.kext[:] = load.kext
-        sub_load.dext[:] = load.dext
-        sub_load.kvref[:] = load.kvref
+        copy_load(load, sub_load)
     cnt = find_touches(parts, tau, x, tc) if nc > 0 else 0
     entries = 0
     if cnt > 0:

@@ -225,7 +225,9 @@ def flow_step(grid, state, lids, n_lid, settings, scratch, dt):
                     Q[k, i, j] = q * out[i, j]
                 elif q < 0.0:
                     Q[k, i, j] = q * out[i + di, j + dj]
-    rate[:, :] = V
+    for i in range(nx):
+        for j in range(ny):
+            rate[i, j] = V[i, j]
     for k in range(4):
         di, dj = _dir(k)
         for i in range(nx):
