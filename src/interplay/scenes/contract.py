@@ -35,7 +35,9 @@ class SceneSpec:
     ``compare``'s advisor wants its debug cycle at most 1/debug_ratio of two-way's
     (analysis/advisor.py; None: the advisor counts work only); contrast: {mode: Result} ->
     {label: value}, figures across the couplings for ``compare`` (the mat's: hybrid's
-    centre-of-mass path off two-way's).
+    centre-of-mass path off two-way's); warm_time (s): how far ``interplay warm`` runs it so
+    that every kernel of a run compiles, past the moment its interactions first act (the
+    ball reaching the net); None: two output frames, when they act from the start.
     """
     name: str
     description: str
@@ -55,6 +57,7 @@ class SceneSpec:
     fit: Callable | None = field(default=None, compare=False)
     debug_ratio: float | None = None
     contrast: Callable | None = field(default=None, compare=False)
+    warm_time: float | None = None
 
     @property
     def default_coupling(self) -> str:
