@@ -123,8 +123,13 @@ def closest_segments(p1, q1, p2, q2):
 
 @njit(cache=True, inline="always")
 def _orient(a, b, c, d):
-    """Six times the signed volume of tetrahedron abcd (> 0: d above the plane abc)."""
-    return np.dot(np.cross(b - a, c - a), d - a)
+    """Six times the signed volume of tetrahedron abcd (> 0: d above the plane abc): (b - a)
+    x (c - a) . (d - a). Scalar arithmetic: this runs twelve times for every candidate pair
+    of every frame's certificate, and NumPy's cross and dot allocated three arrays a call."""
+    ux, uy, uz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    wx, wy, wz = c[0] - a[0], c[1] - a[1], c[2] - a[2]
+    return _dot(uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx,
+                d[0] - a[0], d[1] - a[1], d[2] - a[2])
 
 
 @njit(cache=True)
