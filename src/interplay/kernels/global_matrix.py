@@ -12,6 +12,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .multigrid import Hierarchy, Workspace, vcycle
+from .springs import copy_rows
 
 
 class Direct(NamedTuple):
@@ -92,9 +93,7 @@ def apply_inverse(pre, q, z):
     levels, else the factored solve; z is scratch."""
     if pre.mg.sizes.shape[0] > 0:
         vcycle(pre.mg, pre.work, q, z)
-        for i in range(q.shape[0]):
-            for r in range(3):
-                q[i, r] = z[i, r]
+        copy_rows(z, q)
     else:
         ldl_solve(pre.direct, q, z, q)
 
