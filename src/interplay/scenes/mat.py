@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..control.landing import VaultParams, gymnast
-from ..control.landing_search import LANDING, MARGIN
+from ..control import landing_search
 from ..errors import SceneError
 from ..geometry.anthropometry import SEGMENTS
 from ..geometry.mat import FEET_HALF, MAT_COLOR, MatParams, build_mat
@@ -290,7 +290,7 @@ SPEC = SceneSpec(
            "the mat, then her motion drives it (hybrid)", build, MatSceneParams,
     couplings=("hybrid", "two-way", "one-way"), duration=2.2, fps=60.0,
     integrators=("explicit", "implicit"), standin="standin", fit=fit, figures=landing_figures,
-    searches=(LANDING, MARGIN),
+    searches=(landing_search.LANDING, landing_search.MARGIN),
     debug_ratio=5.0, contrast=contrast,
     # heavy: each trial of its search flies the whole landing twice (seconds)
     camera=Camera((1.9, -6.8, 2.0), (1.9, 0.0, 1.0), 45.0), key_time=0.83, heavy=True)
