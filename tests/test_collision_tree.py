@@ -7,6 +7,7 @@ import pytest
 
 from interplay.errors import ParameterError
 from interplay.geometry.aabb_tree import AABBTree
+from interplay.kernels.aabb_tree import stable_argsort
 from interplay.kernels.trimesh_contact import closest_on_triangle, triangles_intersect
 
 
@@ -216,3 +217,13 @@ def test_edge_edge_proximity_equals_brute_force():
     p = xa[ea[pairs[:, 0], 0]] + st[:, :1] * (xa[ea[pairs[:, 0], 1]] - xa[ea[pairs[:, 0], 0]])
     q = xb[eb[pairs[:, 1], 0]] + st[:, 1:] * (xb[eb[pairs[:, 1], 1]] - xb[eb[pairs[:, 1], 0]])
     assert np.allclose(np.linalg.norm(p - q, axis=1), d, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 3, 63, 64, 65, 1000])
+def test_the_builds_sort_is_numpys_stable_argsort(n):
+    # the tree's median split orders centroids with it; the same permutation as NumPy's
+    # stable sort (ties in their given order) keeps every tree, and every contact sum over
+    # it, the same to the bit as before it replaced np.argsort(kind="mergesort")
+    rng = np.random.default_rng(n)
+    for keys in (rng.random(n), rng.integers(0, 4, n).astype(float), np.zeros(n)):
+        assert np.array_equal(stable_argsort(keys), np.argsort(keys, kind="stable"))

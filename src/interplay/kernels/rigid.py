@@ -141,14 +141,3 @@ def generalized(x, v, q, w, gx, gv):
     gv[4] = 0.5 * (w[0] * q[0] + w[1] * q[3] - w[2] * q[2])
     gv[5] = 0.5 * (-w[0] * q[3] + w[1] * q[0] + w[2] * q[1])
     gv[6] = 0.5 * (w[0] * q[2] - w[1] * q[1] + w[2] * q[0])
-
-
-@njit(cache=True)
-def kinetic_energy(v, q, w, mass, inertia_body):
-    """Translational plus rotational kinetic energy (J)."""
-    R = quat_to_matrix(q)
-    e = 0.0
-    for i in range(3):
-        wb = R[0, i] * w[0] + R[1, i] * w[1] + R[2, i] * w[2]  # (R^T w)_i, the body frame's
-        e += 0.5 * mass * v[i] * v[i] + 0.5 * inertia_body[i] * wb * wb
-    return e
