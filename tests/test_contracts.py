@@ -171,6 +171,17 @@ def test_every_scene_refuses_the_couplings_it_does_not_support(name):
             assert "\n" not in str(err.value) and name in str(err.value)
 
 
+def test_every_scenes_searches_can_be_looked_up_by_name():
+    # `interplay tune SCENE --search NAME` finds a search by its name; a module constant that
+    # shadowed an imported Search (the mat's edge margin, MARGIN = 0.1 m) made it an internal
+    # error
+    from interplay.control.search import Search
+    for sp in all_specs():
+        names = [s.name for s in sp.searches if isinstance(s, Search)]
+        assert len(names) == len(sp.searches) == len(set(names)), (sp.name, sp.searches)
+        assert [sp.search(n).name for n in names] == names
+
+
 # --- the command line ------------------------------------------------------------------------
 QUICK = ["--duration", str(SHORT), "--quiet", "--no-video", "--no-obj", "--no-usd",
          "--no-report"]

@@ -304,9 +304,3 @@ def test_the_capture_point_landing_keeps_its_feet_from_perturbed_takeoffs():
         assert fig["feet moved after touch-down (m)"] < 1.2 * STICK["moved"], (dv, fig)
         stuck += fig["stuck"]
     assert stuck >= 4
-
-
-def test_both_landing_searches_are_registered():
-    # `interplay tune mat --search margin` looked the search up among the scene's searches,
-    # where a module constant of the same name (the landing's 0.1 m margin) had replaced it
-    assert [M.SPEC.search(n).name for n in ("landing", "margin")] == ["landing", "margin"]
