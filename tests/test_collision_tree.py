@@ -7,7 +7,7 @@ import pytest
 
 from interplay.errors import ParameterError
 from interplay.geometry.aabb_tree import AABBTree
-from interplay.kernels.aabb_tree import stable_argsort
+from interplay.kernels.sorting import stable_argsort
 from interplay.kernels.trimesh_contact import closest_on_triangle, triangles_intersect
 
 
@@ -225,5 +225,6 @@ def test_the_builds_sort_is_numpys_stable_argsort(n):
     # stable sort (ties in their given order) keeps every tree, and every contact sum over
     # it, the same to the bit as before it replaced np.argsort(kind="mergesort")
     rng = np.random.default_rng(n)
-    for keys in (rng.random(n), rng.integers(0, 4, n).astype(float), np.zeros(n)):
+    for keys in (rng.random(n), rng.integers(0, 4, n).astype(float), np.zeros(n),
+                 rng.integers(0, 9, n)):  # int keys: the water's lids by column
         assert np.array_equal(stable_argsort(keys), np.argsort(keys, kind="stable"))

@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from .sorting import stable_argsort
 from .trimesh_contact import closest_on_triangle
 
 
@@ -80,33 +81,6 @@ def build(x, elems):
         st[top + 1, 0], st[top + 1, 1], st[top + 1, 2] = right[node], mid, t
         top += 2
     return left, right, prim
-
-
-@njit(cache=True)
-def stable_argsort(keys):
-    """The permutation that sorts ``keys`` (n,) ascending, equal keys in their given order:
-    np.argsort(kind="mergesort")'s, by a bottom-up merge sort written out, since Numba's own
-    sort compiles for ~0.8 s on a first run (half the tree build's compile)."""
-    n = keys.shape[0]
-    a = np.arange(n)
-    b = np.empty(n, np.int64)
-    width = 1
-    while width < n:
-        for lo in range(0, n, 2 * width):
-            mid = min(lo + width, n)
-            hi = min(lo + 2 * width, n)
-            i, j = lo, mid
-            for k in range(lo, hi):
-                # the left run's key wins ties: stable
-                if i < mid and (j >= hi or keys[a[i]] <= keys[a[j]]):
-                    b[k] = a[i]
-                    i += 1
-                else:
-                    b[k] = a[j]
-                    j += 1
-        a, b = b, a
-        width *= 2
-    return a
 
 
 @njit(cache=True, parallel=True)

@@ -23,6 +23,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .sorting import stable_argsort
+
 ELLIPSOID, CAPSULE, BOX = 0, 1, 2
 #: a chord that misses: zlo > zhi
 _MISS = (1.0, 0.0)
@@ -336,8 +338,9 @@ def add_solids(solids, grid, ns, lids, n, owner0):
 def group_lids(lids, n):
     """Sort the first n lids by column (stable: lids of one column keep their order).
     Gathered by a loop, not NumPy's fancy indexing, which costs Numba seconds to compile for
-    each array type (7.5 s against 2.6 s for this kernel on an empty cache)."""
-    order = np.argsort(lids.cell[:n], kind="mergesort")
+    each array type (7.5 s against 2.6 s for this kernel on an empty cache); sorted by
+    ``sorting.stable_argsort``, the same order as NumPy's merge sort without its compile."""
+    order = stable_argsort(lids.cell[:n])
     cell, owner = lids.cell[:n].copy(), lids.owner[:n].copy()
     scale, vz = lids.scale[:n].copy(), lids.vz[:n].copy()
     zlo, zhi = lids.zlo[:n].copy(), lids.zhi[:n].copy()
