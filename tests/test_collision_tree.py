@@ -77,9 +77,10 @@ def test_nearest_triangle_equals_brute_force(sliver):
     assert (tri >= 0).sum() > 200
 
 
-def test_refit_bounds_contain_deformed_triangles():
+@pytest.mark.parametrize("m", [500, 3000])  # below and above PARALLEL_LEAVES (2048)
+def test_refit_bounds_contain_deformed_triangles(m):
     rng = np.random.default_rng(5)
-    x, t = random_soup(rng, 500)
+    x, t = random_soup(rng, m)
     tree = AABBTree(x, t, pad=0.01)
     for _ in range(20):
         x0 = x + rng.normal(0, 0.2, x.shape)
@@ -228,3 +229,15 @@ def test_the_builds_sort_is_numpys_stable_argsort(n):
     for keys in (rng.random(n), rng.integers(0, 4, n).astype(float), np.zeros(n),
                  rng.integers(0, 9, n)):  # int keys: the water's lids by column
         assert np.array_equal(stable_argsort(keys), np.argsort(keys, kind="stable"))
+
+
+def test_serial_and_parallel_refits_fit_the_same_boxes():
+    # the tree refits in one thread below PARALLEL_LEAVES elements: the same boxes, to the bit
+    from interplay.kernels import aabb_tree as K
+    rng = np.random.default_rng(6)
+    x, t = random_soup(rng, 300)
+    x1 = x + rng.normal(0, 0.05, x.shape)
+    a, b = AABBTree(x, t, pad=0.01), AABBTree(x, t, pad=0.01)
+    K.refit(a.tree, a.elements, x, x1, 0.01)
+    K.refit_serial(b.tree, b.elements, x, x1, 0.01)
+    assert np.array_equal(a.lo, b.lo) and np.array_equal(a.hi, b.hi)

@@ -64,7 +64,8 @@ class AABBTree:
         """Refit every box to vertices x (and x_end, the positions at the end of the step)."""
         self.x = check_points(self.owner, x)
         x1 = self.x if x_end is None else check_points(self.owner, x_end)
-        K.refit(self.tree, self.elements, self.x, x1, self.pad)
+        fit = K.refit if len(self.elements) >= K.PARALLEL_LEAVES else K.refit_serial
+        fit(self.tree, self.elements, self.x, x1, self.pad)
 
     def transform(self, R, t, R_end=None, t_end=None):
         """Rigid motion: world boxes from the body-frame boxes at pose (R, t) (and the pose at

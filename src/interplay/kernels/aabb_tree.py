@@ -83,33 +83,60 @@ def build(x, elems):
     return left, right, prim
 
 
-@njit(cache=True, parallel=True)
-def refit(tree, elems, x0, x1, pad):
-    """Boxes of every node: each leaf bounds its element at both x0 and x1 (the start and end of
-    the step, so a contact during the step is not missed), grown by pad (m); interior nodes
-    bound their children. Leaves in parallel (each writes its own box), then the interior
-    nodes backwards (children are numbered after their parents)."""
+PARALLEL_LEAVES = 2048  # elements: from here a refit's leaves go in parallel (``refit``)
+
+
+@njit(cache=True, inline="always")
+def _fit_leaf(tree, elems, x0, x1, pad, node):
+    """The box of one node if it is a leaf: its element at both x0 and x1, grown by pad."""
+    lo, hi, _, _, prim = tree
+    e = prim[node]
+    if e < 0:
+        return
+    for r in range(3):
+        a = np.inf
+        b = -np.inf
+        for j in range(elems.shape[1]):
+            p = elems[e, j]
+            a = min(a, x0[p, r], x1[p, r])
+            b = max(b, x0[p, r], x1[p, r])
+        lo[node, r] = a - pad
+        hi[node, r] = b + pad
+
+
+@njit(cache=True, inline="always")
+def _fit_interior(tree):
+    """Every interior node's box around its children's, backwards (children come after)."""
     lo, hi, left, right, prim = tree
-    k = elems.shape[1]
-    for node in prange(lo.shape[0]):
-        e = prim[node]
-        if e < 0:
-            continue
-        for r in range(3):
-            a = np.inf
-            b = -np.inf
-            for j in range(k):
-                p = elems[e, j]
-                a = min(a, x0[p, r], x1[p, r])
-                b = max(b, x0[p, r], x1[p, r])
-            lo[node, r] = a - pad
-            hi[node, r] = b + pad
     for node in range(lo.shape[0] - 1, -1, -1):
         if prim[node] < 0:
             ln, rn = left[node], right[node]
             for r in range(3):
                 lo[node, r] = min(lo[ln, r], lo[rn, r])
                 hi[node, r] = max(hi[ln, r], hi[rn, r])
+
+
+@njit(cache=True, parallel=True)
+def refit(tree, elems, x0, x1, pad):
+    """Boxes of every node: each leaf bounds its element at both x0 and x1 (the start and end of
+    the step, so a contact during the step is not missed), grown by pad (m); interior nodes
+    bound their children. Leaves in parallel (each writes its own box), then the interior
+    nodes backwards (children are numbered after their parents). For trees of
+    PARALLEL_LEAVES elements or more; below it ``refit_serial`` is as fast and compiles in
+    under half the time (0.4 against 1.1 s on an empty cache). Serial against parallel on 2
+    threads, idle machine: 600 elements 12.4 against 14.7 us, 2,000 even, 20,000 0.90 against
+    0.56 ms."""
+    for node in prange(tree.lo.shape[0]):
+        _fit_leaf(tree, elems, x0, x1, pad, node)
+    _fit_interior(tree)
+
+
+@njit(cache=True)
+def refit_serial(tree, elems, x0, x1, pad):
+    """``refit`` in one thread, for trees of fewer than PARALLEL_LEAVES elements."""
+    for node in range(tree.lo.shape[0]):
+        _fit_leaf(tree, elems, x0, x1, pad, node)
+    _fit_interior(tree)
 
 
 @njit(cache=True)
