@@ -33,31 +33,38 @@ def build(x, elems):
     """Top-down build: split at the median centroid along the widest centroid axis.
 
     Returns (left, right, prim); boxes are filled by ``refit``. 2m-1 nodes."""
+    # arrays made by np.empty and filled by loops: each of NumPy's constructors (np.ones,
+    # np.full, np.zeros) and an array's negation compiles for 0.1-0.2 s on a first run
     m = elems.shape[0]
     k = elems.shape[1]
-    cen = np.zeros((m, 3))
+    cen = np.empty((m, 3))
     for e in range(m):
-        for j in range(k):
-            for r in range(3):
+        for r in range(3):
+            cen[e, r] = 0.0
+            for j in range(k):
                 cen[e, r] += x[elems[e, j], r] / k
     nn = 2 * m - 1
-    left = -np.ones(nn, np.int64)
-    right = -np.ones(nn, np.int64)
-    prim = -np.ones(nn, np.int64)
+    left = np.empty(nn, np.int64)
+    right = np.empty(nn, np.int64)
+    prim = np.empty(nn, np.int64)
+    for node in range(nn):
+        left[node], right[node], prim[node] = -1, -1, -1
     order = np.arange(m)
     # stack of (node, start, end) over order[start:end]
-    st = np.zeros((STACK, 3), np.int64)
+    st = np.empty((STACK, 3), np.int64)
     st[0, 0], st[0, 1], st[0, 2] = 0, 0, m
     top = 1
     nxt = 1
+    lo = np.empty(3)
+    hi = np.empty(3)
     while top > 0:
         top -= 1
         node, s, t = st[top, 0], st[top, 1], st[top, 2]
         if t - s == 1:
             prim[node] = order[s]
             continue
-        lo = np.full(3, np.inf)
-        hi = np.full(3, -np.inf)
+        for r in range(3):
+            lo[r], hi[r] = np.inf, -np.inf
         for i in range(s, t):
             for r in range(3):
                 c = cen[order[i], r]
