@@ -104,7 +104,7 @@ def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrenc
     for q in range(6):
         wrench[q] = 0.0
     reach = radius + thickness
-    k = 0
+    k = np.int64(0)  # not the literal 0: to_segment_ends would compile twice (0 and int64)
     # scratch vectors, allocated once per call rather than per contact
     n = np.empty(3)
     r = np.empty(3)

@@ -412,7 +412,7 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
     omega = 1.0 / (parts.steps * dt)
     wrenches[:, :] = 0.0
     vrel, vt, F = np.empty(3), np.empty(3), np.empty(3)
-    k = 0
+    k = np.int64(0)  # not the literal 0: to_segment_ends would compile twice (0 and int64)
     for i in range(cnt):
         j, ia, ib, t = tc.part[i], tc.ia[i], tc.ib[i], tc.t[i]
         law = parts.law[j]
