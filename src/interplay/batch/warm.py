@@ -4,7 +4,8 @@ worker processes, one per core (docs/first-run.md).
 A kernel compiles the first time a run calls it; building a scene and running two output
 frames of it in each of its couplings (or on to its ``warm_time``, where its contacts first
 act) calls them all, so ``interplay warm`` (which ``make`` runs after installing) leaves a
-user's first ``interplay run`` loading kernels instead of compiling them. The sweep warms its first variant the same way before its workers start.
+user's first ``interplay run`` loading kernels instead of compiling them. The sweep warms its
+first variant the same way before its workers start.
 """
 from __future__ import annotations
 
