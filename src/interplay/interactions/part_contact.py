@@ -18,7 +18,9 @@ Stiffness and damping default to the pair's effective mass and the network's sub
 c_s = m_eff (1/(n dt))^2, c_d = 2 m_eff/(n dt), n = ``contact_steps`` (critically damped, no
 bounce); the constraint term carries a resting load without sinking. Friction is the law's
 regularised Coulomb, capped at the force that stops the slip within a substep, so a planted
-foot drags the bed's points with it instead of skating over them.
+foot drags the bed's points with it instead of skating over them; at low speed that cap is a
+damper of a point's mass over the substep, so a foot pushed steadily creeps, and ``stick``
+holds it instead by a tangential spring per touched point kept between steps.
 """
 from __future__ import annotations
 
@@ -42,7 +44,10 @@ class PartContactParams:
     include the constraint term; margin (m): how much farther than a part can reach in a step
     its candidate elements are gathered; rounding (m): the parts' boxes seen with their edges
     and corners rounded by this radius (within the box; a box primitive's own radius wins),
-    as a torso is: cloth draped over a sharp edge is folded over it, and thrown off it."""
+    as a torso is: cloth draped over a sharp edge is folded over it, and thrown off it;
+    stick: friction sticks through a tangential spring per touched point, kept from step to
+    step (contact_law.sticking_friction), instead of the regularised law, whose viscous range
+    lets a foot pushed steadily along a soft network creep at v = F dt / m_point."""
     thickness: float = param(0.004, "m", ge=0.0, le=0.2)
     friction: float = param(0.8, "-", ge=0.0, le=10.0)
     eps: float = param(0.01, "m/s", gt=0.0, le=10.0)
@@ -52,6 +57,7 @@ class PartContactParams:
     constraint: bool = param(True, doc="include the constraint term")
     margin: float = param(0.01, "m", ge=0.0, le=1.0)
     rounding: float = param(0.0, "m", ge=0.0, le=0.2, doc="boxes' edges rounded by this radius")
+    stick: bool = param(False, doc="friction sticks (a spring per touched point), no creep")
 
     def validated(self, owner: str) -> "PartContactParams":
         require_nonnegative(owner, "contact thickness", self.thickness, "m")
@@ -157,26 +163,35 @@ class PartContact(Interaction):
                 p[j], size[j, 0] = np.asarray(pr.centre) - off, pr.radius
                 reach[j] = np.linalg.norm(p[j]) + pr.radius
         law = np.tile(self.p.law(), (k, 1))
+        n = len(self.net.x) if self.p.stick else 0
         return PC.Parts(kind, p, q, size, reach, np.zeros((k, 3)), np.zeros((k, 3, 3)),
                         np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
                         np.asarray(v.masses, float)[own].copy(), law,
                         float(self.p.contact_steps),
                         elems, np.zeros(k + 1, np.int64), np.zeros(k * len(elems), np.int64),
-                        np.zeros((k, 7)), np.zeros(1), np.zeros(3))
+                        np.zeros((k, 7)), np.zeros(1), np.zeros(3),
+                        np.zeros((k, n, 3)), np.full((k, n), -2, np.int64),
+                        np.zeros(1, np.int64), np.zeros((k, n, 3)), np.zeros((k, n)))
 
     def prepare(self, h, dts=None):
         self._h = h
 
     def capture(self) -> dict:
-        """The stand-in's memory and the deepest penetration so far (the rigid-parts contact
-        itself keeps no state between steps)."""
+        """The stand-in's memory, the deepest penetration so far and, when friction sticks,
+        the touched points' springs."""
         cap = getattr(self.standin, "capture", None)
         out = {f"standin_{k}": v for k, v in cap().items()} if cap else {}
         out["deepest"] = np.array(self.deepest)
+        if self.p.stick:
+            P = self.parts
+            out.update(stretch=P.stretch.copy(), stamp=P.stamp.copy(), clock=P.clock.copy())
         return out
 
     def restore(self, snap: dict):
         self.deepest = float(snap["deepest"])
+        if self.p.stick:
+            for key in ("stretch", "stamp", "clock"):
+                getattr(self.parts, key)[...] = snap[key]
         if self.standin is not None and hasattr(self.standin, "restore"):
             self.standin.restore({k[8:]: v for k, v in snap.items() if k.startswith("standin_")})
 
@@ -194,6 +209,7 @@ class PartContact(Interaction):
         self._motion()
         net = self.net
         if PC.candidates(self.parts, net.x, net.v, self._h, self.p.margin) == 0:
+            self.parts.clock[0] += 1  # a step without contact: the next one starts unstretched
             self.n_contacts = 0
             self.parts.impulses[:] = 0.0
             self.parts.received[:] = 0.0

@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS, to_segment_ends
-from .contact_law import friction_damping, normal_force, sliding_friction
+from .contact_law import friction_damping, normal_force, sliding_friction, sticking_friction
 
 SPHERE, CAPSULE, BOX = 0, 1, 2
 KINDS = {"sphere": SPHERE, "capsule": CAPSULE, "box": BOX}
@@ -45,7 +45,12 @@ class Parts(NamedTuple):
     Out: impulses (k,7) impulse (N s), angular impulse about the centre of mass (N m s) and
     peak force (N) per part over the step; peak (1,) the largest total force (N) of any
     substep; received (3,) the impulse (N s) the network's points received (minus the parts'
-    sum: the exchange is equal and opposite)."""
+    sum: the exchange is equal and opposite).
+    Sticking friction (``touch_forces``) when stretch has a row per network point, else it is
+    (k,0,3) and the friction is the regularised law: stretch (k,n,3) m, each point's
+    tangential spring to where it first held on part k; stamp (k,n) the call of
+    ``touch_forces`` that last set it, clock (1,) the calls so far; sums (k,n,3) and weights
+    (k,n) the calls' scratch (zero between calls)."""
     kind: np.ndarray
     p: np.ndarray
     q: np.ndarray
@@ -65,6 +70,11 @@ class Parts(NamedTuple):
     impulses: np.ndarray
     peak: np.ndarray
     received: np.ndarray
+    stretch: np.ndarray
+    stamp: np.ndarray
+    clock: np.ndarray
+    sums: np.ndarray
+    weights: np.ndarray
 
 
 @njit(cache=True)
@@ -407,11 +417,19 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
     part's; Jacobians and vref when ``with_jacobian``) and each part's force (0:3) and torque
     about its centre of mass (3:6) into ``wrenches`` (k,6); clears tc.share. dt (s): the
     step the forces are held for (friction's cap; its inverse over ``parts.steps`` the law's
-    rate where the law gives no stiffness). Returns the entries written."""
+    rate where the law gives no stiffness). Where ``parts`` keeps a stretch per point, friction
+    sticks (contact_law.sticking_friction): a contact's spring is its ends' stretches weighted
+    as its point is, and each end keeps the weighted mean of its contacts' new stretches; an
+    end that no contact of the part held at the previous call starts from none. Returns the
+    entries written."""
     x, v, m, _ = pts
     omega = 1.0 / (parts.steps * dt)
     wrenches[:, :] = 0.0
     vrel, vt, F = np.empty(3), np.empty(3), np.empty(3)
+    stick = parts.stretch.shape[1] > 0
+    clock = parts.clock[0] + 1
+    parts.clock[0] = clock
+    spring, ft_stick = np.empty(3), np.empty(3)
     k = np.int64(0)  # not the literal 0: to_segment_ends would compile twice (0 and int64)
     for i in range(cnt):
         j, ia, ib, t = tc.part[i], tc.ia[i], tc.ib[i], tc.t[i]
@@ -439,9 +457,20 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
             vt[r] = vrel[r] - vn * n[r]
             vtn += vt[r] * vt[r]
         vtn = np.sqrt(vtn)
-        ft = -sliding_friction(fn, vtn, mu, eps, inv_m, dt) / vtn if vtn > 0.0 else 0.0
-        for r in range(3):
-            F[r] = fn * n[r] + ft * vt[r]
+        if stick:
+            _gather(parts, j, ia, ib, wa, wb, clock, spring)
+            _, visc = sticking_friction(n, vt, fn, cs, cd, mu, eps, meff, dt, spring, ft_stick)
+            for r in range(3):
+                F[r] = fn * n[r] + ft_stick[r]
+                parts.sums[j, ia, r] += wa * spring[r]
+                parts.sums[j, ib, r] += wb * spring[r]
+            parts.weights[j, ia] += wa
+            parts.weights[j, ib] += wb
+        else:
+            ft = -sliding_friction(fn, vtn, mu, eps, inv_m, dt) / vtn if vtn > 0.0 else 0.0
+            for r in range(3):
+                F[r] = fn * n[r] + ft * vt[r]
+            visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
         rx, ry, rz = (tc.P[i, 0] - tc.c[j, 0], tc.P[i, 1] - tc.c[j, 1],
                       tc.P[i, 2] - tc.c[j, 2])
         wrenches[j, 0] += F[0]
@@ -450,10 +479,45 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
         wrenches[j, 3] += ry * F[2] - rz * F[1]
         wrenches[j, 4] += rz * F[0] - rx * F[2]
         wrenches[j, 5] += rx * F[1] - ry * F[0]
-        visc = friction_damping(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
         k = to_segment_ends(out, k, (ia, ib, wa, wb), F, n, tc.vp[i], (cs, cd, visc),
                             with_jacobian)
     for i in range(cnt):
         tc.share[tc.ia[i]] = 0.0
         tc.share[tc.ib[i]] = 0.0
+        if stick:
+            _keep(parts, tc.part[i], tc.ia[i], clock)
+            _keep(parts, tc.part[i], tc.ib[i], clock)
     return k
+
+
+@njit(cache=True, inline="always")
+def _gather(parts, j, ia, ib, wa, wb, clock, spring):
+    """A contact's tangential spring (m) into ``spring``: the mean of its ends' stretches on
+    part j, weighted wa, wb (ib == ia: one point), over the ends held at the previous call
+    (an edge sliding in under a foot takes on the stretch of its end already there: counted
+    as none, it would pull the contact's spring down at every edge that comes in, and the
+    foot creep); none held: no stretch."""
+    for r in range(3):
+        spring[r] = 0.0
+    held = 0.0
+    for side in range(1 if ia == ib else 2):
+        p, w = (ia, wa) if side == 0 else (ib, wb)
+        if parts.stamp[j, p] == clock - 1:
+            held += w
+            for r in range(3):
+                spring[r] += w * parts.stretch[j, p, r]
+    if held > 0.0:
+        for r in range(3):
+            spring[r] /= held
+
+
+@njit(cache=True, inline="always")
+def _keep(parts, j, p, clock):
+    """Point p's stretch on part j: the weighted mean of this call's contacts' springs."""
+    w = parts.weights[j, p]
+    if w > 0.0:
+        for r in range(3):
+            parts.stretch[j, p, r] = parts.sums[j, p, r] / w
+            parts.sums[j, p, r] = 0.0
+        parts.weights[j, p] = 0.0
+        parts.stamp[j, p] = clock
