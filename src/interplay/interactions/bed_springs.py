@@ -19,7 +19,10 @@ law's regularised Coulomb friction (kernels/contact_law.sliding_friction, the la
 rigid-parts contact applies on the network's side): mu times the normal share times
 min(1, |v_t| / eps), capped at the force that stops the point's slip within the coupling
 step (its share of the part's mass), so that the stand-in and the two-way contact hold a
-planted foot by the same law. A stand-in has no mass,
+planted foot by the same law; or, with ``stick`` > 0, the grid's springs cannot slide: each
+point is held by a tangential spring-damper to where it touched down (its anchor), which
+slips, dragging the anchor, only past mu times its normal share, so a foot pushed steadily
+comes to rest instead of creeping at the capped law's F h / m. A stand-in has no mass,
 no horizontal pull towards the bed's centre and no recoil lag of its own: what the two-way run
 adds is measured in docs/trampoline.md.
 """
@@ -43,8 +46,10 @@ class BedSpringsParams:
     deepest point a support point still touches the bed; friction_damping (N s/m) per
     point against sliding, friction (-) its cap over the normal share; eps (m/s): when > 0
     the tangential law is the contact law's regularised Coulomb friction instead (full at
-    this slip speed; friction_damping is then unused); enabled: false turns
-    the stand-in off (the hybrid primary then falls freely)."""
+    this slip speed; friction_damping is then unused); stick (N/m), stick_damping (N s/m):
+    when stick > 0 each touching point's tangential spring and damper to its anchor instead
+    (eps and friction_damping unused), capped at friction times its share; enabled: false
+    turns the stand-in off (the hybrid primary then falls freely)."""
     # fitted to BedParams() (docs/trampoline.md)
     linear: float = param(1953.0, "N/m", ge=0.0, le=1e7)
     quadratic: float = param(4172.0, "N/m^2", ge=-1e7, le=1e7)
@@ -55,6 +60,8 @@ class BedSpringsParams:
     friction: float = param(0.8, "-", ge=0.0, le=10.0)
     eps: float = param(0.0, "m/s", ge=0.0, le=10.0,
                        doc="> 0: the contact law's Coulomb friction, full at this slip")
+    stick: float = param(0.0, "N/m", ge=0.0, le=1e7, doc="> 0: points anchored where they touched")
+    stick_damping: float = param(0.0, "N s/m", ge=0.0, le=1e6)
     enabled: bool = param(True, doc="false: the hybrid primary falls freely")
 
     def validated(self) -> "BedSpringsParams":
@@ -122,6 +129,14 @@ class BedSprings(StandIn):
         self.part = np.concatenate(part)
         self.masses = np.asarray(view.masses, float)
         self._zero = np.zeros(3)
+        self.anchor = np.zeros((len(self.local), 2))  # m: where each point touched down
+        self.held = np.zeros(len(self.local), bool)  # touching at the last call
+
+    def capture(self) -> dict:
+        return {"anchor": self.anchor.copy(), "held": self.held.copy()}
+
+    def restore(self, snap: dict):
+        self.anchor[:], self.held[:] = snap["anchor"], snap["held"]
 
     def act(self, body):
         p = self.p
@@ -134,6 +149,7 @@ class BedSprings(StandIn):
         depth = self.surface - x[:, 2]
         D = depth.max()
         if D <= 0.0:
+            self.held[:] = False
             return self._zero, self._zero, False
         on = np.flatnonzero(depth > max(D - p.pocket, 0.0))
         part, xs, d = self.part[on], x[on], depth[on] - max(D - p.pocket, 0.0)
@@ -150,16 +166,20 @@ class BedSprings(StandIn):
         f[:, 2] = share
         vt = v[:, :2]
         speed = np.linalg.norm(vt, axis=1)
-        if p.eps > 0.0:
-            # the contact law's friction (kernels/contact_law.sliding_friction), with each
-            # point's share of its part's mass as the effective mass of the cap
-            m = self.masses[part] / np.bincount(slot)[slot]
-            fmag = np.minimum(p.friction * share * np.minimum(1.0, speed / p.eps),
-                              m * speed / self.step)
-            cap = fmag / np.maximum(speed, 1e-12)
+        if p.stick > 0.0:
+            f[:, :2] = self._anchored(on, xs[:, :2], vt, p.friction * share)
         else:
-            cap = np.minimum(p.friction_damping, p.friction * share / np.maximum(speed, 1e-12))
-        f[:, :2] = -cap[:, None] * vt
+            if p.eps > 0.0:
+                # the contact law's friction (kernels/contact_law.sliding_friction), with each
+                # point's share of its part's mass as the effective mass of the cap
+                m = self.masses[part] / np.bincount(slot)[slot]
+                fmag = np.minimum(p.friction * share * np.minimum(1.0, speed / p.eps),
+                                  m * speed / self.step)
+                cap = fmag / np.maximum(speed, 1e-12)
+            else:
+                cap = np.minimum(p.friction_damping,
+                                 p.friction * share / np.maximum(speed, 1e-12))
+            f[:, :2] = -cap[:, None] * vt
         tau = np.cross(r, f)
         for j in touched:
             sel = part == j
@@ -168,3 +188,21 @@ class BedSprings(StandIn):
         total = f.sum(axis=0)
         torque = np.cross(xs - view.centre_of_mass(), f).sum(axis=0)
         return total, torque, True
+
+    def _anchored(self, on, xy, vt, limit):
+        """(m,2) N: the touching points' (``on``, at xy m, slipping at vt m/s) springs and
+        dampers to their anchors, each capped at ``limit`` N; a point that just touched down
+        is anchored where it is, a capped one drags its anchor to where the cap holds."""
+        p = self.p
+        anchor = self.anchor[on]
+        new = ~self.held[on]
+        anchor[new] = xy[new]
+        ft = -p.stick * (xy - anchor) - p.stick_damping * vt
+        mag = np.linalg.norm(ft, axis=1)
+        slip = mag > limit
+        ft[slip] *= (limit[slip] / mag[slip])[:, None]
+        anchor[slip] = xy[slip] + (ft[slip] + p.stick_damping * vt[slip]) / p.stick
+        self.anchor[on] = anchor
+        self.held[:] = False
+        self.held[on] = True
+        return ft

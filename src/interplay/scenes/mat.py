@@ -149,17 +149,54 @@ def press_flat(net, depth: float, half: float = FEET_HALF, seconds: float = 0.4,
     sole carries then (the springs' push on the held points less their weight). Leaves the
     network at rest, unloaded."""
     sel = pressed_points(net, half)
+    return float(held_sole(net, sel, depth, (0.0, 0.0), seconds, damping, h)[:, 2].sum())
+
+
+def held_sole(net, sel, depth: float, shift=(0.0, 0.0), seconds: float = 0.4,
+              damping: float = 100.0, h: float = 1e-2) -> np.ndarray:
+    """(len(sel),3) N: the forces the top points ``sel`` carry, held as one rigid flat sole
+    that does not slide, lowered ``depth`` m and moved ``shift`` (x, y) m, the rest of the mat
+    relaxed by damped backward Euler, bottom layer held (the springs' push on the held points
+    less their weight). Leaves the network at rest, unloaded."""
     x0, fixed = net.x.copy(), net.fixed.copy()
     net.fixed[net.bottom] = True
     net.fixed[sel] = True
 
     def lower(k, n):
         # lowered over the first half, as ``press`` ramps its load (no snap-through)
-        net.x[sel, 2] = x0[sel, 2] - depth * min(1.0, 2.0 * (k + 1) / n)
+        s = min(1.0, 2.0 * (k + 1) / n)
+        net.x[sel, 2] = x0[sel, 2] - depth * s
+        net.x[sel, 0] = x0[sel, 0] + shift[0] * s
+        net.x[sel, 1] = x0[sel, 1] + shift[1] * s
     relax(net, seconds, h, damping, 4000, lower)
-    load = float(net.internal_forces()[sel, 2].sum())
+    f = net.internal_forces()[sel]
     net.x[:], net.fixed[:] = x0, fixed
-    return load
+    return f
+
+
+def fit_stick(params: "MatSceneParams", standin: BedSpringsParams, shift: float = 0.005) -> dict:
+    """The stand-in's tangential springs (``BedSpringsParams.stick``): the mat's sideways
+    stiffness under one of her soles (her foot's box, its top points held flat at the depth
+    where the stand-in's curve carries her standing weight, moved ``shift`` m along x and
+    along y: the mean of the two) over the four corners by which the stand-in holds a flat
+    box; their damping the foam's retardation time times that (kd = tau k, as the lattice's
+    foam springs). Returns the fit and what it was fitted to."""
+    from scipy.optimize import brentq
+    fig = gymnast(params.vault, floor=params.mat.thickness)
+    view = fig.contact_view()
+    weight = float(np.sum(view.masses)) * 9.81
+    foot = view.primitives[SEGMENTS.index("l_foot")].axes
+    depth = brentq(lambda d: standin.force(d) - weight, 0.0, params.mat.thickness)
+    net = mat_network(params.mat, "implicit")
+    top = net.x[net.top]
+    c = 0.5 * (top.min(axis=0) + top.max(axis=0))
+    sel = net.top[(np.abs(top[:, 0] - c[0]) <= foot[0]) & (np.abs(top[:, 1] - c[1]) <= foot[1])]
+    k = [-held_sole(net, sel, depth, s)[:, axis].sum() / shift
+         for axis, s in ((0, (shift, 0.0)), (1, (0.0, shift)))]
+    stick = float(np.mean(k)) / 4.0
+    return {"stick": stick, "stick_damping": params.mat.foam_damping * stick,
+            "sole_points": int(len(sel)), "standing_depth_m": float(depth),
+            "sole_shear_N_per_m": [float(v) for v in k]}
 
 
 def load_deflection(p: MatParams, depths) -> np.ndarray:
@@ -213,12 +250,14 @@ def fit(spec, params: MatSceneParams, **build_kw) -> dict:
     err = np.abs(model - rows[:, 0]) / rows[:, 0]
     mat_drops = drop_test(params.mat, FIT_DROPS)
     damping, standin_drops = fit_damping(sp, mat_drops)
+    shear = fit_stick(params, sp)
 
     def rel(key):
         return max(abs(s[key] - m[key]) / m[key] for s, m in zip(standin_drops, mat_drops))
-    fitted = {"linear": a, "quadratic": b, "cubic": c, "damping": damping}
+    fitted = {"linear": a, "quadratic": b, "cubic": c, "damping": damping,
+              "stick": shear.pop("stick"), "stick_damping": shear.pop("stick_damping")}
     return {"fit": fitted, "loads_N": rows[:, 0].tolist(), "depressions_m": rows[:, 1].tolist(),
-            "fitted_N": model.tolist(), "max_error_rel": float(err.max()),
+            "fitted_N": model.tolist(), "max_error_rel": float(err.max()), "shear": shear,
             "drops": {"mat": mat_drops, "standin": standin_drops,
                       "peak_error_rel": rel("peak_mean_force_N"),
                       "rebound_error_rel": rel("rebound_m_s")},
