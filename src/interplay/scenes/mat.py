@@ -61,13 +61,16 @@ class MatSceneParams:
     forces; air_density (kg/m^3) of the drag on her segments."""
     mat: MatParams = MatParams()
     vault: VaultParams = VaultParams()
-    contact: PartContactParams = PartContactParams(friction=1.0)
-    # fitted to MatParams() by `interplay fit-standin mat` (docs/mat.md); tangentially the
-    # contact's own friction law (mu and eps as ``contact``: docs/mat.md, the stand-in)
+    # friction that sticks: under the regularised law a planted foot crept over the foam's
+    # points at F dt / m_point (docs/mat.md, "Friction that sticks")
+    contact: PartContactParams = PartContactParams(friction=1.0, stick=True)
+    # fitted to MatParams() by `interplay fit-standin mat` (docs/mat.md): the curve, its
+    # damping and, tangentially, each point anchored where it touched down by the mat's
+    # shear stiffness under a sole (mu as ``contact``)
     standin: BedSpringsParams = BedSpringsParams(linear=70776.7, quadratic=505032.0,
                                                  cubic=0.0, damping=284.152, pocket=0.03,
-                                                 friction_damping=2000.0, friction=1.0,
-                                                 eps=0.01)
+                                                 friction=1.0, stick=82110.0,
+                                                 stick_damping=246.33)
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
     air_density: float = param(1.2, "kg/m^3", ge=0.0, le=100.0)
 
