@@ -413,3 +413,14 @@ def test_the_stand_ins_anchored_points_hold_a_pushed_stance():
         replace(M.MatSceneParams().standin, stick=0.0, eps=0.01), 50.0)
     assert np.abs(held).max() < 0.01
     assert crept[-1] > 0.05
+
+
+def test_fitting_anchors_to_a_mat_too_soft_to_stand_on_is_refused_in_one_line():
+    """``fit_stick`` needs her standing depth on the curve: a curve that cannot carry her
+    weight within the mat's thickness is named as such, before the mat is built."""
+    p = M.MatSceneParams()
+    soft = replace(p.standin, linear=1000.0, quadratic=0.0, cubic=0.0)
+    with pytest.raises(SceneError, match=r"mat: the stand-in's curve carries 200 N at the "
+                                         r"mat's full thickness \(0.2 m\), less than her "
+                                         r"standing weight 632 N: the mat is too soft"):
+        M.fit_stick(p, soft)

@@ -189,6 +189,12 @@ def fit_stick(params: "MatSceneParams", standin: BedSpringsParams, shift: float 
     view = fig.contact_view()
     weight = float(np.sum(view.masses)) * 9.81
     foot = view.primitives[SEGMENTS.index("l_foot")].axes
+    full = standin.force(params.mat.thickness)
+    if full < weight:
+        raise SceneError(f"mat: the stand-in's curve carries {full:.0f} N at the mat's full "
+                         f"thickness ({params.mat.thickness:g} m), less than "
+                         f"her standing weight {weight:.0f} N: the mat is too soft to stand on; "
+                         "stiffen it (mat.modulus, mat.cover) or thicken it (mat.thickness)")
     depth = brentq(lambda d: standin.force(d) - weight, 0.0, params.mat.thickness)
     net = mat_network(params.mat, "implicit")
     top = net.x[net.top]
