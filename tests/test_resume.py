@@ -78,6 +78,23 @@ def test_resume_repeats_the_uninterrupted_run_bit_for_bit(name, saves, tmp_path)
     same_result(reference, resumed)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("mode", ["two-way", "hybrid"])
+def test_resume_mid_landing_keeps_the_sticking_friction(mode, tmp_path):
+    """The mat's friction keeps state between steps (the contact's springs per touched point,
+    the stand-in's anchors): a run saved at 0.85 s, 0.08 s after her feet touch down, and
+    resumed repeats the uninterrupted one bit for bit, in two-way (the contact's springs) and
+    in hybrid (the save falls in her pass, on the anchored stand-in)."""
+    sp = spec("mat")
+    reference = sp.build(mode, duration=0.95).simulate()
+    ck = _killed_after(Checkpointer(tmp_path / "checkpoint.npz", every_s=0.85,
+                                    every_wall_s=None), 1)
+    with pytest.raises(_Stop):
+        sp.build(mode, duration=0.95).simulate(checkpointer=ck)
+    resumed = sp.build(mode, duration=0.95).simulate(resume=read(tmp_path / "checkpoint.npz"))
+    same_result(reference, resumed)
+
+
 def test_a_checkpoint_of_another_scene_is_refused(tmp_path):
     from interplay.errors import OutputError
     ck = _killed_after(Checkpointer(tmp_path / "c.npz", every_s=0.05, every_wall_s=None), 1)
