@@ -335,7 +335,8 @@ class Touches(NamedTuple):
     element ends ia, ib (c,), parameter t (c,), penetration pen (c,) m, normal n (c,3)
     (element towards part), part surface point P (c,3) m and its velocity vp (c,3) m/s;
     per part its predicted centre of mass c (k,3) m at the substep; per network point the
-    summed closest-point weight share (n,) of its contacts (zero between substeps)."""
+    summed closest-point weight share (n,) of its contacts (zero between substeps); tau (1,)
+    s the substep's time into the step."""
     part: np.ndarray
     ia: np.ndarray
     ib: np.ndarray
@@ -346,6 +347,7 @@ class Touches(NamedTuple):
     vp: np.ndarray
     c: np.ndarray
     share: np.ndarray
+    tau: np.ndarray
 
 
 def touches(capacity: int, parts: int, points: int) -> Touches:
@@ -353,7 +355,7 @@ def touches(capacity: int, parts: int, points: int) -> Touches:
     return Touches(np.zeros(capacity, np.int64), np.zeros(capacity, np.int64),
                    np.zeros(capacity, np.int64), np.zeros(capacity), np.zeros(capacity),
                    np.zeros((capacity, 3)), np.zeros((capacity, 3)), np.zeros((capacity, 3)),
-                   np.zeros((parts, 3)), np.zeros(points))
+                   np.zeros((parts, 3)), np.zeros(points), np.zeros(1))
 
 
 @njit(cache=True)
@@ -365,6 +367,7 @@ def find_touches(parts, tau, x, tc):
     lo, hi = np.empty(3), np.empty(3)
     A, B, X, P, n = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     cand, elems = parts.cand, parts.elems
+    tc.tau[0] = tau
     cnt = 0
     for j in range(parts.kind.shape[0]):
         if parts.start[j + 1] == parts.start[j]:
@@ -429,7 +432,7 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
     stick = parts.stretch.shape[1] > 0
     clock = parts.clock[0] + 1
     parts.clock[0] = clock
-    spring, ft_stick = np.empty(3), np.empty(3)
+    spring, ft_stick, vs = np.empty(3), np.empty(3), np.empty(3)
     k = np.int64(0)  # not the literal 0: to_segment_ends would compile twice (0 and int64)
     for i in range(cnt):
         j, ia, ib, t = tc.part[i], tc.ia[i], tc.ib[i], tc.t[i]
@@ -458,8 +461,17 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
             vtn += vt[r] * vt[r]
         vtn = np.sqrt(vtn)
         if stick:
+            # the spring follows the slip on the part's motion at the step's start, without
+            # its free acceleration's a tau: the step's impulse takes that away from the real
+            # motion (a held part would otherwise stretch by a h^2 / 2 a step and be pushed
+            # back against its load at a h / 2)
+            an_t = 0.0
+            for r in range(3):
+                an_t += parts.accels[j, r] * n[r]
+            for r in range(3):
+                vs[r] = vt[r] - (parts.accels[j, r] - an_t * n[r]) * tc.tau[0]
             _gather(parts, j, ia, ib, wa, wb, clock, spring)
-            _, visc = sticking_friction(n, vt, fn, cs, cd, mu, eps, meff, dt, spring, ft_stick)
+            _, visc = sticking_friction(n, vs, fn, cs, cd, mu, eps, meff, dt, spring, ft_stick)
             for r in range(3):
                 F[r] = fn * n[r] + ft_stick[r]
                 parts.sums[j, ia, r] += wa * spring[r]

@@ -254,7 +254,7 @@ def _part_work(net, load, parts):
                         np.zeros((2 * nc, 3))),
             Touches(np.zeros(nc, np.int64), np.zeros(nc, np.int64), np.zeros(nc, np.int64),
                     np.zeros(nc), np.zeros(nc), np.zeros((nc, 3)), np.zeros((nc, 3)),
-                    np.zeros((nc, 3)), np.zeros((k_parts, 3)), np.zeros(n)),
+                    np.zeros((nc, 3)), np.zeros((k_parts, 3)), np.zeros(n), np.zeros(1)),
             np.zeros((k_parts, 6)),
             Load(np.empty_like(load.f), np.empty_like(load.kext), np.empty_like(load.dext),
                  np.empty_like(load.kvref)),
