@@ -94,11 +94,14 @@ def mat_network(p: MatParams, integrator: str = "implicit", dt: float | None = N
     return net
 
 
-def pressed_points(net, half: float = FEET_HALF) -> np.ndarray:
-    """Indices of the mat's top points within ``half`` (m) of its top's centre in x and y."""
+def pressed_points(net, half: float = FEET_HALF, half_y: float | None = None) -> np.ndarray:
+    """Indices of the mat's top points within ``half`` (m) of its top's centre in x and
+    ``half_y`` (default ``half``) in y."""
+    half_y = half if half_y is None else half_y
     top = net.x[net.top]
     c = 0.5 * (top.min(axis=0) + top.max(axis=0))
-    near = (np.abs(top[:, 0] - c[0]) <= half + 1e-9) & (np.abs(top[:, 1] - c[1]) <= half + 1e-9)
+    near = ((np.abs(top[:, 0] - c[0]) <= half + 1e-9)
+            & (np.abs(top[:, 1] - c[1]) <= half_y + 1e-9))
     return net.top[near]
 
 
@@ -197,9 +200,7 @@ def fit_stick(params: "MatSceneParams", standin: BedSpringsParams, shift: float 
                          "stiffen it (mat.modulus, mat.cover) or thicken it (mat.thickness)")
     depth = brentq(lambda d: standin.force(d) - weight, 0.0, params.mat.thickness)
     net = mat_network(params.mat, "implicit")
-    top = net.x[net.top]
-    c = 0.5 * (top.min(axis=0) + top.max(axis=0))
-    sel = net.top[(np.abs(top[:, 0] - c[0]) <= foot[0]) & (np.abs(top[:, 1] - c[1]) <= foot[1])]
+    sel = pressed_points(net, foot[0], foot[1])
     k = [-held_sole(net, sel, depth, s)[:, axis].sum() / shift
          for axis, s in ((0, (shift, 0.0)), (1, (0.0, shift)))]
     stick = float(np.mean(k)) / 4.0
