@@ -18,6 +18,7 @@ from .base import Interaction
 
 
 LAWS = ("plate", "delta")
+CENTRES = ("triangles", "chord")
 
 
 @dataclass(frozen=True)
@@ -39,7 +40,15 @@ class AeroParams:
 
     drag: c_n (kg/m^3), 0.5 rho C_D with C_D ~ 1.2 for a flat plate across the flow;
     friction: c_t (kg/(m^2 s)), linear skin friction along the surface; density (kg/m^3),
-    potential (K_p, 1/rad), vortex (K_v) and stall (deg): the delta law's."""
+    potential (K_p, 1/rad), vortex (K_v) and stall (deg): the delta law's.
+
+    centre: where the normal force acts. ``triangles`` (SPEC 2.2): each triangle's at its
+    centroid, so a flat sail's centre of pressure is its area centroid at every angle;
+    ``chord``: the body is one flat sail whose centre of pressure moves along its chord with
+    the angle of attack as a flat plate's does, from a quarter chord at small angles to the
+    centroid across the flow (``kernels.aero.chordwise_centre``). A kite's pitch trims on
+    that: its towing point picks the angle at which the centre of pressure lies on its line.
+    """
     drag: float = param(0.7, "kg/m^3", ge=0.0, le=100.0, doc="c_n, 0.5 rho C_D")
     friction: float = param(0.02, "kg/(m^2 s)", ge=0.0, le=100.0, doc="c_t")
     law: str = param("plate", "-", choices=LAWS, doc="normal force law")
@@ -47,6 +56,7 @@ class AeroParams:
     potential: float = param(2.5, "1/rad", ge=0.0, le=6.3, doc="K_p (delta law)")
     vortex: float = param(3.14, "-", ge=0.0, le=4.0, doc="K_v (delta law)")
     stall: float = param(30.0, "deg", gt=0.0, le=90.0, doc="vortex breakdown (delta law)")
+    centre: str = param("triangles", "-", choices=CENTRES, doc="centre of pressure")
 
 
 class _AirOn(Interaction):
@@ -82,9 +92,14 @@ class Aerodynamics(_AirOn):
         self.cn = require_nonnegative(name, "drag", params.drag, "kg/m^3")
         self.ct = require_nonnegative(name, "friction", params.friction, "kg/(m^2 s)")
         self.law = _law(name, params)
+        if params.centre not in CENTRES:
+            raise ParameterError(f"interaction {name}: unknown centre of pressure "
+                                 f"{params.centre!r}; choose one of {', '.join(CENTRES)} "
+                                 "(aero.centre)")
         n = len(self.body.x)
         self._buffers(n)
         self._cent = np.zeros((len(self.tris), 3))
+        self._info = np.zeros((len(self.tris), 8)) if params.centre == "chord" else None
 
     def forces(self, with_jacobian=False):
         """(point forces (n,3) N, their velocity Jacobian (n,3,3) N s/m, total force (3,) N)."""
@@ -95,7 +110,10 @@ class Aerodynamics(_AirOn):
         if with_jacobian:
             self._dfdv[:] = 0.0
         total = K.triangle_forces(body.x, body.v, self.tris, wind, self.cn, self.ct, self._f,
-                                  self._dfdv, with_jacobian, *self.law)
+                                  self._dfdv, with_jacobian, *self.law, self._info)
+        if self._info is not None:
+            total = total + K.chordwise_centre(body.x, self.tris, self._cent, self._info,
+                                               self._f)
         return self._f, self._dfdv, total
 
 

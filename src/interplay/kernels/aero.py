@@ -39,7 +39,7 @@ def normal_coefficient(sa, law, cn, kp, kv, sin_stall, c_stall):
 
 @njit(cache=True)
 def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian, law=0, kp=0.0, kv=0.0,
-                    sin_stall=1.0, c_stall=0.0):
+                    sin_stall=1.0, c_stall=0.0, info=None):
     """Add each triangle's force f/3 (N) to f (n,3) of its points; return the total force.
 
     wind (m,3): the wind velocity (m/s) at each centroid; cn (N s^2/m^4 per m^2 of area and
@@ -51,6 +51,9 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian, law=0, kp=
     the plate law when v is along n) lumped as 1/3 to each point (the row sum over the three
     points sharing the triangle's velocity). The loop is serial: the scatter to shared
     points stays race-free, and a scene's aerodynamic meshes are small next to its springs.
+    info (m,8), if given, receives per triangle its unit normal n (3), its normal force along
+    n (N), its area s (m^2) and its velocity relative to the wind (3, m/s), for
+    ``chordwise_centre``.
     """
     total = np.zeros(3)
     for t in range(tris.shape[0]):
@@ -79,6 +82,9 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian, law=0, kp=
         c = cn if law == 0 or speed == 0.0 else normal_coefficient(
             abs(vn) / speed, law, cn, kp, kv, sin_stall, c_stall)
         cnn = -c * s * speed * vn
+        if info is not None:
+            info[t, 0], info[t, 1], info[t, 2], info[t, 3] = n0, n1, n2, cnn
+            info[t, 4], info[t, 5], info[t, 6], info[t, 7] = s, r0, r1, r2
         f0 = cnn * n0 - ct * s * (r0 - vn * n0)
         f1 = cnn * n1 - ct * s * (r1 - vn * n1)
         f2 = cnn * n2 - ct * s * (r2 - vn * n2)
@@ -98,6 +104,117 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian, law=0, kp=
                     for b in range(3):
                         eye = 1.0 if a == b else 0.0
                         dfdv[p, a, b] -= (dn * nn[a] * nn[b] + dt * (eye - nn[a] * nn[b])) / 3.0
+    return total
+
+
+BETA = 40.0  # the largest |b|: exp(-40) moves the whole force to the leading edge
+BISECTIONS = 50  # halves the bracket of b to 80 / 2^50
+
+
+@njit(cache=True)
+def chordwise_centre(x, tris, cent, info, f):
+    """Move a flat sail's centre of pressure along its chord as a flat plate's moves with its
+    angle of attack, keeping each triangle's force normal to it and the sum of their sizes.
+
+    The per-triangle law puts each triangle's normal force at its centroid, so the sail's
+    centre of pressure is its area centroid x_A at every angle. A flat plate's lies at
+    0.2 + 0.3 sin a of the chord c from its leading edge (Joessel's measurements; ESDU 70015,
+    1970): a quarter chord near a = 0, the centroid at 90 deg. Generalised to any planform as
+    x_le + (x_A - x_le)(0.4 + 0.6 sin a) along the chord, which is that for a rectangle.
+
+    The sail's plane is its area-weighted normal N (each triangle's normal turned to agree with
+    the first's), its flow the area-weighted mean of the triangles' velocities relative to the
+    wind V (info's columns 4-7, from ``triangle_forces``); a = the angle between V and the
+    plane; the chord runs downstream along V's part in the plane, from the most upstream point
+    (x_le). Each triangle's normal force F_t (info column 3, along its normal, columns 0-2) is
+    scaled by w_t = exp(-b u_t) W (u_t its centroid's chord position over the chord's length,
+    W keeping sum |F_t| w_t = sum |F_t|), b found by bisection so that the forces' centre
+    (weighted by |F_t| w_t) lies at the plate's. The change, (w_t - 1) F_t n_t, is added to
+    f (n,3) N, a third to each point; returns its total (3,) N (zero for a flat sail: a
+    couple). cent (m,3): the triangles' centroids (m). The velocity Jacobian is left as the
+    per-triangle law's: the couple only moves where the force acts.
+    """
+    m = tris.shape[0]
+    total = np.zeros(3)
+    ref = -1
+    for t in range(m):
+        if info[t, 4] > 0.0:
+            ref = t
+            break
+    if ref < 0:
+        return total
+    N = np.zeros(3)
+    V = np.zeros(3)
+    area = 0.0
+    for t in range(m):
+        s = info[t, 4]
+        if s <= 0.0:
+            continue
+        d = info[t, 0] * info[ref, 0] + info[t, 1] * info[ref, 1] + info[t, 2] * info[ref, 2]
+        sgn = -1.0 if d < 0.0 else 1.0
+        for r in range(3):
+            N[r] += s * sgn * info[t, r]
+            V[r] += s * info[t, 5 + r]
+        area += s
+    nn = np.sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2])
+    speed = np.sqrt(V[0] * V[0] + V[1] * V[1] + V[2] * V[2]) / area
+    if nn == 0.0 or speed == 0.0:
+        return total
+    N /= nn
+    V /= area
+    vn = V[0] * N[0] + V[1] * N[1] + V[2] * N[2]
+    e = -(V - vn * N)  # the air's flow along the plane, downstream
+    el = np.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    if el <= 1e-9 * speed:
+        return total  # the flow meets the plane square on: the centroid is the plate's centre
+    e /= el
+    sin_a = abs(vn) / speed
+    le, hi = np.inf, -np.inf
+    for i in range(tris.shape[0]):
+        for k in range(3):
+            p = tris[i, k]
+            xs = x[p, 0] * e[0] + x[p, 1] * e[1] + x[p, 2] * e[2]
+            le = min(le, xs)
+            hi = max(hi, xs)
+    chord = hi - le
+    xi = np.empty(m)
+    mag = np.empty(m)
+    xa, total_mag = 0.0, 0.0
+    for t in range(m):
+        xi[t] = cent[t, 0] * e[0] + cent[t, 1] * e[1] + cent[t, 2] * e[2]
+        mag[t] = abs(info[t, 3]) if info[t, 4] > 0.0 else 0.0
+        xa += info[t, 4] * xi[t] if info[t, 4] > 0.0 else 0.0
+        total_mag += mag[t]
+    if total_mag == 0.0 or chord <= 0.0:
+        return total
+    xa /= area
+    target = le + (xa - le) * (0.4 + 0.6 * sin_a)
+    lo_b, hi_b = -BETA, BETA  # the centre moves upstream as b grows
+    for _ in range(BISECTIONS):
+        b = 0.5 * (lo_b + hi_b)
+        num, den = 0.0, 0.0
+        for t in range(m):
+            w = mag[t] * np.exp(-b * (xi[t] - le) / chord)
+            num += w * xi[t]
+            den += w
+        if num / den > target:
+            lo_b = b
+        else:
+            hi_b = b
+    b = 0.5 * (lo_b + hi_b)
+    den = 0.0
+    for t in range(m):
+        den += mag[t] * np.exp(-b * (xi[t] - le) / chord)
+    scale = total_mag / den
+    for t in range(m):
+        if info[t, 4] <= 0.0:
+            continue
+        dw = (np.exp(-b * (xi[t] - le) / chord) * scale - 1.0) * info[t, 3]
+        for r in range(3):
+            d = dw * info[t, r]
+            total[r] += d
+            for k in range(3):
+                f[tris[t, k], r] += d / 3.0
     return total
 
 
