@@ -69,20 +69,22 @@ class RokkakuParams:
 @dataclass(frozen=True)
 class StuntParams:
     """A two-line stunt delta. span (m) between the wingtips; length (m) of the spine; sweep
-    (m): how far back from the nose the wingtips are; dihedral (deg); spreader (fraction of
+    (m): how far back from the nose the wingtips are; dihedral (deg): each wingtip this far
+    out of the spine's plane, back (downwind, > 0) or forward towards the flyer (< 0: the sail
+    a shallow V open to the wind, which is what steers the stunt kite the way it is pulled in
+    the per-triangle aerodynamics: docs/kites.md); spreader (fraction of
     each leading edge from the nose): the upper spreader; lower (fraction of the spine and of
     each leading edge): the lower spreaders' ends. Each side's bridle has three legs meeting
     at that side's towing point (tow: fraction of the spine from the nose, projected;
     tow_side (m) off the spine; tow_height (m) in front of the sail): the upper leg from the
     spine at upper (fraction from the nose), the lower leg from the middle of that side's
-    lower spreader and the outer leg from where it meets the leading edge. The upper leg
-    pulls its end out towards the towing point ahead of the frame's centre of mass and the
-    other two pull theirs in behind it, so a pull on one line turns the kite's nose to that
-    side as it rolls it (its force tilting to that side): pull left to turn left."""
+    lower spreader and the outer leg from where it meets the leading edge. A pull on one line
+    rolls the kite, tilting its force to that side; whether the nose follows to that side is
+    the design's (its dihedral and where its mass and centre of pressure lie)."""
     span: float = param(2.2, "m", gt=0.0, le=20.0)
     length: float = param(0.85, "m", gt=0.0, le=20.0)
     sweep: float = param(0.55, "m", gt=0.0, le=20.0)
-    dihedral: float = param(8.0, "deg", ge=0.0, lt=45.0)
+    dihedral: float = param(8.0, "deg", ge=-45.0, lt=45.0)
     spreader: float = param(0.45, "-", ge=0.0, le=1.0)
     lower: float = param(0.7, "-", ge=0.0, le=1.0)
     bridle: tuple = param((0.12, 0.78, 0.62), "-", ge=0.0, le=1.0, length=3)
@@ -152,9 +154,9 @@ def _fraction(owner, name, value):
     return v
 
 
-def _dihedral(owner, deg):
-    if not 0.0 <= deg < 45.0:
-        raise ParameterError(f"{owner}: dihedral must be in [0, 45) deg, got {deg!r}")
+def _dihedral(owner, deg, low=0.0):
+    if not low <= deg < 45.0:
+        raise ParameterError(f"{owner}: dihedral must be in [{low:g}, 45) deg, got {deg!r}")
     return math.radians(deg)
 
 
@@ -214,7 +216,7 @@ def stunt(p: StuntParams, n: int = 8) -> KiteGeometry:
     S = require_positive("stunt", "span", p.span, "m")
     L = require_positive("stunt", "length", p.length, "m")
     sweep = require_positive("stunt", "sweep", p.sweep, "m")
-    g = _dihedral("stunt", p.dihedral)
+    g = _dihedral("stunt", p.dihedral, low=-45.0)
     nose, foot = np.zeros(3), np.array([-L, 0.0, 0.0])
     left = np.array([-sweep, S / 2 * math.cos(g), -S / 2 * math.sin(g)])
     right = left * [1.0, -1.0, 1.0]

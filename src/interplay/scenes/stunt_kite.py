@@ -5,10 +5,17 @@ as a person flies: it watches the kite, pulls one side to turn it, and flies a l
 figure-8 on command (``--set control.manoeuvre=figure8``). The pilot is kinematic (it stands
 firm), so the lines act on it one-way, in lock step with the kite.
 
-The kite flies flat (no dihedral) with a weight at the foot of its spine (a stunt kite's tail
-weight): in the per-triangle aerodynamics of SPEC 2.2 the sail's centre of pressure stays at
-its centroid, so the weight behind it is what makes a pull on one line turn the nose to that
-side, and the tail's drag damps the pitch (docs/kites.md derives both).
+The kite is built to fly in the per-triangle aerodynamics of SPEC 2.2 (docs/kites.md derives
+and measures each choice):
+
+* its sail's centre of pressure moves along the chord with the angle of attack as a flat
+  plate's does (``AeroParams(centre="chord")``), so the kite trims in pitch on its towing
+  point and pulls with its sail's force, not with a weight behind it: no tail weight;
+* its wingtips are swept forward of the spine, towards the flyer (dihedral -25 deg): with
+  them back, a kite in this law turns away from the line that is pulled; forward, towards it;
+* the pilot's full steering is a 0.8 m difference between the hands (``control.throw`` 0.4),
+  and each loop begins high (``control.ready`` 50 deg, the window's top is 52-56 deg): the
+  loops then clear the ground.
 """
 from __future__ import annotations
 
@@ -19,6 +26,7 @@ import numpy as np
 
 from ..control.kite_pilot import StuntPilot, StuntPilotParams, window_coordinates
 from ..geometry.kite import SparParams, StuntParams, stunt
+from ..interactions.aero import AeroParams
 from ..outputs.render.camera import Camera
 from ..params import param
 from ..scene import Scene
@@ -36,13 +44,14 @@ LAUNCH_ALPHA = 25.0  # deg: its sail's angle to the wind then, near how it flies
 class StuntKiteParams:
     """The kite's design, its components, the pilot and how it flies, the wind; coupling_dt
     (s): the step at which the components exchange forces."""
-    kite: StuntParams = StuntParams(dihedral=0.0, ballast=0.15, tow=0.36, tow_height=0.6,
+    kite: StuntParams = StuntParams(dihedral=-25.0, ballast=0.0, tow=0.30, tow_height=0.6,
                                     spars=SparParams(radius=0.003, density=600.0))
     parts: KP.KiteParams = KP.KiteParams(
         line=KP.LineParams(radius=3e-4, density=3e-4),
-        tail=KP.TailParams(length=2.5, segments=10, bow_area=0.01))
+        tail=KP.TailParams(length=2.5, segments=10, bow_area=0.01),
+        aero=AeroParams(centre="chord"))
     pilot: PilotParams = PilotParams()
-    control: StuntPilotParams = StuntPilotParams()
+    control: StuntPilotParams = StuntPilotParams(throw=0.4, ready=50.0)
     wind: KP.KiteWind = KP.KiteWind(speed=8.0, turbulence=0.05)
     coupling_dt: float = param(1.0 / 240.0, "s", ge=1e-6, le=0.05)
 
