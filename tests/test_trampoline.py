@@ -349,6 +349,23 @@ def test_tune_refuses_bad_requests_before_any_trial(tmp_path, capsys):
     assert not (tmp_path / "t" / "evaluations.jsonl").exists()
 
 
+
+def test_basin_search_scores_the_worst_of_nearby_drops(monkeypatch):
+    """The basin search's loss is the worst (highest) of the bounce loss from the scene's
+    drop and from a millimetre above and below it: a controller that bounces from one start
+    and falls from the next is scored by the fall."""
+    from interplay.control import bounce_search as BS
+    seen = []
+
+    def fake(coupling, kw):  # 3 good bounces from the drop itself, 1 from the others
+        drop = kw["params"].gymnast.drop
+        seen.append(round(drop, 6))
+        return -3.0 if abs(drop - 1.0) < 1e-9 else -1.0
+    monkeypatch.setattr(BS, "bounce_loss", fake)
+    assert BS.basin_loss("two-way", {"params": T.TrampolineParams(), "duration": 5.0}) == -1.0
+    assert sorted(seen) == [0.999, 1.0, 1.001]
+    assert T.SPEC.search("bounce-basin").bounds == T.SPEC.search("bounce").bounds
+
 # --- the default run ----------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def default_run():

@@ -179,6 +179,26 @@ BOUNCE = Search(
     bounds={f"bounce.{k}": v for k, v in BOUNDS.items()}, loss=bounce_loss, budget=100,
     chains=4, t_start=1.0, t_end=0.01, step=0.1)
 
+#: m: the drops a basin trial starts from, about the scene's: a millimetre moves the shipped
+#: controller's second landing by centimetres and decides its third (docs/trampoline.md)
+BASIN_DROPS = (0.0, -0.001, 0.001)
+
+
+def basin_loss(coupling: str, kw: dict) -> float:
+    """The basin search's loss: ``bounce_loss`` from each of BASIN_DROPS added to the scene's
+    drop, the worst of them, so a controller scores what it keeps over nearby starts, not
+    what one trajectory's luck gives it. Costs len(BASIN_DROPS) trials."""
+    from dataclasses import replace
+    p = kw["params"]
+    return max(bounce_loss(coupling, {**kw, "params": replace(p, gymnast=replace(
+        p.gymnast, drop=p.gymnast.drop + d))}) for d in BASIN_DROPS)
+
+
+BASIN = Search(
+    "bounce-basin", "the bounce controller over nearby starts: the worst of three drops a "
+    "millimetre apart", bounds=BOUNCE.bounds, loss=basin_loss, budget=100, chains=4,
+    t_start=1.0, t_end=0.01, step=0.1)
+
 
 def record_of(result, bed_height: float) -> tuple[BounceRecord, list, float, tuple]:
     """The BounceRecord of a finished run (a Result), rebuilt from its data: landings and

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..control.bounce import BounceBalance, BounceParams, controller
-from ..control.bounce_search import BOUNCE
+from ..control.bounce_search import BASIN, BOUNCE
 from ..outputs.render.camera import Camera
 from ..geometry.anthropometry import BodyParams
 from ..geometry.trampoline import BedParams, build_bed, frame_mesh
@@ -206,6 +206,6 @@ def figures(result) -> dict:
 SPEC = SceneSpec(
     "trampoline", "a gymnast bounces on a spring-mass trampoline (two-way)", build,
     TrampolineParams, couplings=("two-way", "hybrid", "one-way"), duration=20.0, fps=60.0,
-    integrators=("explicit",), searches=(BOUNCE,), figures=figures,
+    integrators=("explicit",), searches=(BOUNCE, BASIN), figures=figures,
     camera=Camera((2.6, -7.6, 2.6), (0.0, 0.0, 1.8), 40.0), key_time=0.65, heavy=True,
     warm_time=0.5)  # she lands at 0.45 s
