@@ -69,6 +69,8 @@ def triangle_forces(x, v, tris, wind, cn, ct, f, dfdv, with_jacobian, law=0, kp=
         n2 = e10 * e21 - e11 * e20
         a2 = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
         if a2 == 0.0:
+            if info is not None:
+                info[t, 4] = 0.0  # no area: no force for chordwise_centre to move
             continue
         n0 /= a2
         n1 /= a2
