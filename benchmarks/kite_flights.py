@@ -5,7 +5,7 @@ kite came down, each line's taut share). Writes DIR/kite_flights.json; nothing p
 fails here (the tests assert the physics; this records what the scenes do).
 
     .venv/bin/python benchmarks/kite_flights.py --out out/bench [--seeds 10] [--quick]
-        [--only single|stunt] [--stunt-duration 36]
+        [--only single|stunt] [--stunt-duration 36] [--set KEY=VALUE ...]
 """
 from __future__ import annotations
 
@@ -28,14 +28,15 @@ def single(duration, overrides=None):
             "kites": {name: kites.flight(res, name) for name in kites.KITES}}
 
 
-def stunt(manoeuvre, seed, duration):
-    """One stunt flight in the gusts of ``seed``: the scene's figures."""
-    p = stunt_kite.StuntKiteParams()
+def stunt(manoeuvre, seed, duration, overrides=None):
+    """One stunt flight in the gusts of ``seed``, the scene's parameters changed by
+    ``overrides`` ({--set key: value}): the scene's figures."""
+    p = apply(stunt_kite.StuntKiteParams(), overrides or {})
     p = replace(p, control=replace(p.control, manoeuvre=manoeuvre),
                 wind=replace(p.wind, seed=seed))
     t0 = time.perf_counter()
     res = stunt_kite.build(duration=duration, fps=10.0, params=p).simulate()
-    return {"seed": seed, "wall_s": time.perf_counter() - t0,
+    return {"seed": seed, "overrides": overrides or {}, "wall_s": time.perf_counter() - t0,
             "figures": stunt_kite.figures(res)}
 
 
@@ -44,6 +45,8 @@ def main():
         ap.add_argument("--seeds", type=int, default=10)
         ap.add_argument("--only", choices=("single", "stunt"), default=None)
         ap.add_argument("--stunt-duration", type=float, default=36.0)
+        ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a stunt-kite parameter for every stunt flight")
     a, _ = parse_args(__doc__, more)
     long = 30.0 if a.quick else 130.0
     seeds = range(2 if a.quick else a.seeds)
@@ -53,7 +56,8 @@ def main():
         out["diamond_without_tail"] = single(60.0 if not a.quick else 30.0,
                                              {"diamond_parts.tail.length": "0"})
     if a.only != "single":
-        out["stunt"] = {m: [stunt(m, s, a.stunt_duration) for s in seeds]
+        sets = dict(kv.split("=", 1) for kv in a.set)
+        out["stunt"] = {m: [stunt(m, s, a.stunt_duration, sets) for s in seeds]
                         for m in ("loop", "figure8")}
         out["stunt_summary"] = summary(out["stunt"])
     print(write_json(a.out, f"kite_flights{'_' + a.only if a.only else ''}.json", out))
