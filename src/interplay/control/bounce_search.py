@@ -12,7 +12,7 @@ upright body.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -188,7 +188,6 @@ def basin_loss(coupling: str, kw: dict) -> float:
     """The basin search's loss: ``bounce_loss`` from each of BASIN_DROPS added to the scene's
     drop, the worst of them, so a controller scores what it keeps over nearby starts, not
     what one trajectory's luck gives it. Costs len(BASIN_DROPS) trials."""
-    from dataclasses import replace
     p = kw["params"]
     return max(bounce_loss(coupling, {**kw, "params": replace(p, gymnast=replace(
         p.gymnast, drop=p.gymnast.drop + d))}) for d in BASIN_DROPS)

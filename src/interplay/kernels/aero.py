@@ -204,14 +204,12 @@ def chordwise_centre(x, tris, cent, info, f):
         else:
             hi_b = b
     b = 0.5 * (lo_b + hi_b)
-    den = 0.0
-    for t in range(m):
-        den += mag[t] * np.exp(-b * (xi[t] - le) / chord)
-    scale = total_mag / den
+    w = np.exp(-b * (xi - le) / chord)
+    scale = total_mag / (mag * w).sum()
     for t in range(m):
         if info[t, 4] <= 0.0:
             continue
-        dw = (np.exp(-b * (xi[t] - le) / chord) * scale - 1.0) * info[t, 3]
+        dw = (w[t] * scale - 1.0) * info[t, 3]
         for r in range(3):
             d = dw * info[t, r]
             total[r] += d
