@@ -21,6 +21,12 @@ Built once per body plan:
    vertex), then smoothed over the mesh (``weight_smoothing`` umbrella passes): the surface bends
    smoothly at the joints and never cracks, as every vertex is one point moved by a convex
    combination of rigid motions.
+4. **Kept apart where limbs meet** (``contact_gap``): linear blending lets two limbs' skins
+   pass through each other where they touch (the inner thighs as the legs pass, the armpit as
+   an arm comes down). A vertex that lies within CONTACT_REACH of another limb's solid in the
+   A-pose is, once posed, kept at least ``contact_gap`` (or its A-pose distance, if nearer)
+   outside that solid, pushed out along the solid's gradient: soft tissue pressed flat
+   against its neighbour, both sides the same way, so the two skins meet without crossing.
 
 It works for any system with the RigidParts poses of the 17 segments (Figure, MocapFigure):
 ``pose(seg_pos, seg_rot)`` gives the world vertices. ``BodySurface.sdf`` is the A-pose body's
@@ -36,6 +42,14 @@ from ..errors import ParameterError
 from ..params import param
 from .anthropometry import SEGMENTS, BodyParams, body_plan
 
+#: the body's limbs: a skin vertex belongs to the one that holds most of its weight
+LIMBS = {"trunk": ("pelvis", "torso", "head"),
+         "l_arm": ("l_upper_arm", "l_forearm", "l_hand"),
+         "r_arm": ("r_upper_arm", "r_forearm", "r_hand"),
+         "l_leg": ("l_thigh", "l_shank", "l_foot", "l_toes"),
+         "r_leg": ("r_thigh", "r_shank", "r_foot", "r_toes")}
+CONTACT_REACH = 0.06  # m: how near another limb's solid an A-pose vertex is watched
+CONTACT_PASSES = 3  # pushes, each followed by a smoothing pass, before the last push
 #: limb round-cone radii as multiples of the segment's capsule radius (proximal, distal):
 #: limbs taper towards the wrist and ankle (a capsule of one radius is a mannequin's limb)
 TAPER = {"upper_arm": (1.05, 0.8), "forearm": (0.95, 0.65), "hand": (0.75, 0.7),
@@ -54,8 +68,9 @@ class SurfaceParams:
     arm_abduction: float = param(40.0, "deg", ge=0.0, le=90.0)
     leg_abduction: float = param(6.0, "deg", ge=0.0, le=30.0)
     skin_width: float = param(0.02, "m", gt=0.0, le=0.5)
-    weight_smoothing: int = param(8, "passes", ge=0, le=200)
-    smoothing: int = param(4, "passes", ge=0, le=50)
+    weight_smoothing: int = param(32, "passes", ge=0, le=200)
+    smoothing: int = param(16, "passes", ge=0, le=50)
+    contact_gap: float = param(0.004, "m", ge=0.0, le=0.05)
 
 
 def _rot_x(a):
@@ -174,12 +189,26 @@ def smooth_min(a, b, k):
     return np.minimum(a, b) - h * h * k / 4.0
 
 
+def solid_distance(local, items) -> np.ndarray:
+    """(n,) signed distance (m) of points in a segment's frame to the union of its solids."""
+    return np.min([_solid_distance(local, it) for it in items], axis=0)
+
+
+def solid_gradient(local, items, eps: float = 1e-5) -> np.ndarray:
+    """(n,3) central-difference gradient of ``solid_distance`` (unit length off the surface)."""
+    g = np.empty_like(local)
+    for a in range(3):
+        d = np.zeros(3)
+        d[a] = eps
+        g[:, a] = (solid_distance(local + d, items) - solid_distance(local - d, items)) / (2 * eps)
+    return g
+
+
 def segment_distances(points, plan_solids, pos, rot) -> np.ndarray:
     """(n,17) signed distance (m) of world points to each segment's solids posed at (pos, rot)."""
     out = np.empty((len(points), len(plan_solids)))
     for k, items in enumerate(plan_solids):
-        local = (points - pos[k]) @ rot[k]
-        out[:, k] = np.min([_solid_distance(local, it) for it in items], axis=0)
+        out[:, k] = solid_distance((points - pos[k]) @ rot[k], items)
     return out
 
 
@@ -324,6 +353,7 @@ class BodySurface:
         self.vertices0, self.triangles = v, t
         self._nbr = (start, nbr)
         self.weights = self._weights(v, start, nbr)
+        self.contacts = self._contacts(v) if params.contact_gap > 0 else []
 
     # --- geometry at the A-pose ------------------------------------------------------------------
     def _bounds(self):
@@ -398,6 +428,49 @@ class BodySurface:
         w[w < 1e-4] = 0.0
         return w / w.sum(axis=1, keepdims=True)
 
+    def _contacts(self, v) -> list:
+        """[(segment k, vertices (m,), least distance (m,) m)]: the vertices of other limbs
+        within CONTACT_REACH of segment k's solid in the A-pose, and the distance each keeps
+        from it when posed (``contact_gap``, or its A-pose distance if nearer)."""
+        names = [s.name for s in self.plan]
+        limb_of = np.array([next(i for i, parts in enumerate(LIMBS.values()) if n in parts)
+                            for n in names])
+        share = np.stack([self.weights[:, limb_of == i].sum(axis=1)
+                          for i in range(len(LIMBS))], axis=1)
+        limb = share.argmax(axis=1)
+        d = segment_distances(v, self.solids, self.pos0, self.rot0)
+        out = []
+        for k in range(len(names)):
+            near = np.flatnonzero((limb != limb_of[k]) & (d[:, k] < CONTACT_REACH))
+            if len(near):
+                out.append((k, near, np.minimum(self.params.contact_gap,
+                                                np.maximum(d[near, k], 0.0))))
+        return out
+
+    def _keep_apart(self, X, seg_pos, seg_rot) -> np.ndarray:
+        """Posed vertices X (n,3) with each watched vertex pushed out of the other limb's solid
+        to its least distance (``_contacts``); between pushes the watched vertices are
+        smoothed, so a pushed patch bends into its neighbours instead of folding over them."""
+        if not self.contacts:
+            return X
+        watched = np.unique(np.concatenate([idx for _, idx, _ in self.contacts]))
+        for _ in range(CONTACT_PASSES):
+            X = self._push(X, seg_pos, seg_rot)
+            X[watched] = 0.5 * X[watched] + 0.5 * umbrella(X, *self._nbr)[watched]
+        return self._push(X, seg_pos, seg_rot)
+
+    def _push(self, X, seg_pos, seg_rot) -> np.ndarray:
+        for k, idx, least in self.contacts:
+            local = (X[idx] - seg_pos[k]) @ seg_rot[k]
+            d = solid_distance(local, self.solids[k])
+            deep = np.flatnonzero(d < least)
+            if len(deep):
+                p = local[deep]
+                g = solid_gradient(p, self.solids[k])
+                p += ((least[deep] - d[deep]) / np.maximum((g * g).sum(axis=1), 1e-12))[:, None] * g
+                X[idx[deep]] = p @ seg_rot[k].T + seg_pos[k]
+        return X
+
     # --- posing ----------------------------------------------------------------------------------
     def transforms(self, seg_pos, seg_rot):
         """Per segment, (A (17,3,3), b (17,3)): x = A x0 + b carries A-pose points with it.
@@ -410,13 +483,16 @@ class BodySurface:
 
     def pose(self, seg_pos, seg_rot, points=None) -> np.ndarray:
         """World vertices (n,3) m at the segments' poses (positions (17,3), rotations
-        (17,3,3)); ``points``: other A-pose points carried the same way (a garment)."""
+        (17,3,3)), limbs kept apart where they meet; ``points``: other A-pose points carried
+        by the weights alone (a garment)."""
         A, b = self.transforms(seg_pos, seg_rot)
         x0 = self.vertices0 if points is None else points
         w = self.weights if points is None else self.weights_at(points)
         out = np.zeros_like(x0)
         for k in np.flatnonzero(w.any(axis=0)):
             out += w[:, k, None] * (x0 @ A[k].T + b[k])
+        if points is None:
+            out = self._keep_apart(out, np.asarray(seg_pos, float), np.asarray(seg_rot, float))
         return out
 
     def weights_at(self, points) -> np.ndarray:
