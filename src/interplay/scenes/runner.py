@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..geometry.body_surface import SurfaceParams, figure_surface
+from ..geometry.clearance import ClearanceParams
 from ..geometry.garment import Fit, join, network, sweatpants, tee
 from ..interactions.mesh_contact import MeshContactParams, SelfContact
 from ..interactions.skin_contact import PosedSkin, SkinContact, SkinContactParams
@@ -31,8 +32,9 @@ from .contract import SceneSpec
 
 @dataclass(frozen=True)
 class RunnerParams:
-    """clip: a BVH clip in the mocap folder ("" or absent: the keyframed run); skin: the body
-    surface; tee, pants: how each garment is cut; contact: cloth on skin; self_thickness (m):
+    """clip: a BVH clip in the mocap folder ("" or absent: the keyframed run); clearance: the
+    gaps its limbs keep on our body (geometry/clearance.py); skin: the body surface; tee,
+    pants: how each garment is cut; contact: cloth on skin; self_thickness (m):
     the garments' contact skin against themselves (0: no self-collision); cloth_dt (s): the
     cloth's step, which is the coupling step (the skin contact resolves every step);
     lg_iterations: the cloth solver's iterations per step; dress_s (s): dressing by moving
@@ -40,6 +42,7 @@ class RunnerParams:
     skin's weights at once), settle_s (s): then settling on the still body, before t = 0."""
     clip: str = param("cmu_02_03_run.bvh", check=check_clip,
                       doc="a BVH clip in the mocap folder or a path; empty: keyframes")
+    clearance: ClearanceParams = ClearanceParams()
     skin: SurfaceParams = SurfaceParams(spacing=0.025)
     tee: Fit = Fit(spacing=0.016)
     pants: Fit = Fit(spacing=0.016, ease=0.025)
@@ -124,12 +127,14 @@ def _runner(params: RunnerParams):
     """(the runner MocapFigure, where its motion comes from)."""
     path = clip_path(params.clip) if params.clip else None
     if path is not None and path.exists():
-        return MocapFigure("runner", path, ground=0.0, units=None), f"clip {params.clip}"
+        return (MocapFigure("runner", path, ground=0.0, units=None,
+                            clearance=params.clearance), f"clip {params.clip}")
     import tempfile
     from pathlib import Path
     tmp = Path(tempfile.mkdtemp(prefix="interplay-run-")) / "keyframed_run.bvh"
     keyframed_run(tmp)
-    return (MocapFigure("runner", tmp, ground=0.0, units="cm", skip_tpose=False),
+    return (MocapFigure("runner", tmp, ground=0.0, units="cm", skip_tpose=False,
+                        clearance=params.clearance),
             "keyframed run (no clip in the mocap folder)")
 
 
@@ -205,7 +210,11 @@ def build(coupling: str = "one-way", duration: float = 1.4, fps: float = 30.0,
                                "pants": int(len(pants.vertices)),
                                "skin": int(len(surface.vertices0))},
                   "garments": {g.name: {"mass_kg": g.mass, "fabric": g.fabric.name,
-                                        "sizes": g.sizes} for g in (shirt, pants)}}
+                                        "sizes": g.sizes} for g in (shirt, pants)},
+                  # the abduction the clip gained so its limbs clear each other on our body
+                  "clearance_deg": {k: {"max": round(float(np.degrees(a.max())), 1),
+                                        "mean": round(float(np.degrees(a.mean())), 1)}
+                                    for k, a in runner.clearance.items()}}
     scene.runner_contact = contact
     return scene
 
@@ -217,6 +226,7 @@ def figures(result) -> dict:
     out = {k: v for k, v in cert.items() if k != "per_frame"}
     out["motion"] = result.meta.get("motion")
     out["vertices"] = result.meta.get("vertices")
+    out["clearance_deg"] = result.meta.get("clearance_deg")
     return out
 
 

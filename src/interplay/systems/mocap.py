@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..geometry.anthropometry import (SEGMENTS, BodyParams, body_plan, segment_mesh,
                                       segment_primitive)
+from ..geometry.clearance import ClearanceParams, clear_limbs, forward
 from ..io.motion_file import BVHError, Motion, check_file, read_bvh
 from ..kernels.rigid import quat_mul
 from .base import Role, System
@@ -103,13 +104,16 @@ class MocapFigure(System, RigidParts):
     frame that is a calibration pose, not motion (``tpose_first``: the CMU clips have one);
     position_offset (m): where the clip is placed; ground: None, a height (m) or a function
     height(x, y) -> z (m) of the terrain: the clip is then lifted or lowered, stance by stance,
-    so that each standing foot's sole rests on it (``plant``), easing between stances."""
+    so that each standing foot's sole rests on it (``plant``), easing between stances;
+    clearance: None, or the gaps the limbs keep on our body (geometry/clearance.py: the
+    abduction added per frame, rad, is kept as ``clearance``)."""
 
     role = Role.PRESCRIBED
     integrator = "retargeted BVH clip, cubic spline playback"
 
     def __init__(self, name: str, path, mass: float = 75.0, units: str | None = None,
-                 skip_tpose: bool = True, position_offset=(0.0, 0.0, 0.0), ground=None):
+                 skip_tpose: bool = True, position_offset=(0.0, 0.0, 0.0), ground=None,
+                 clearance: ClearanceParams | None = None):
         motion = read_bvh(path)
         super().__init__(name, motion.frame_time)
         if units is not None and units not in UNITS:
@@ -144,7 +148,6 @@ class MocapFigure(System, RigidParts):
         self.joint_index = idx
         F = len(pos)
         seg_rot = np.zeros((F, 17, 3, 3))
-        seg_pos = np.zeros((F, 17, 3))
         for k, seg in enumerate(self.plan):
             j = idx[seg.name]
             Q = np.eye(3)
@@ -153,11 +156,12 @@ class MocapFigure(System, RigidParts):
             if np.linalg.norm(bone) > 1e-9:  # some clips have zero-length end bones
                 Q = _rotation_between(seg.bone, bone)
             seg_rot[:, k] = rot[:, j] @ Q
-            if seg.parent is None:
-                seg_pos[:, k] = pos[:, j]
-            else:
-                p = SEGMENTS.index(seg.parent)
-                seg_pos[:, k] = seg_pos[:, p] + seg_rot[:, p] @ seg.offset
+        root = pos[:, idx[self.plan[0].name]]
+        self.clearance = {}
+        if clearance is not None:
+            seg_rot, self.clearance = clear_limbs(self.plan, root, seg_rot, motion.frame_time,
+                                                  clearance)
+        seg_pos = forward(self.plan, root, seg_rot)
         self.plant_offsets = np.zeros(F)
         if ground is not None:
             self.plant_offsets = self.plant(seg_pos, seg_rot, motion.frame_time, ground)
