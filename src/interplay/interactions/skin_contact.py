@@ -33,8 +33,8 @@ import numpy as np
 
 from ..errors import ParameterError, require_nonnegative, require_positive
 from ..geometry.aabb_tree import AABBTree
-from ..kernels.skin_contact import (Law, Nearest, Skin, project, reaction, signed_distance,
-                                    vertex_normals)
+from ..kernels.skin_contact import (Law, Nearest, Skin, edge_neighbours, project, reaction,
+                                    signed_distance, vertex_normals)
 from ..params import param
 from .base import Interaction
 
@@ -59,6 +59,7 @@ class PosedSkin:
     def __init__(self, figure, surface):
         self.figure, self.surface = figure, surface
         self.tris = np.ascontiguousarray(surface.triangles, np.int64)
+        self.across = edge_neighbours(self.tris)
 
     def now(self):
         f = self.figure
@@ -87,6 +88,7 @@ class _Projector:
         self.view = cloth.contact_view()
         self.p = params
         self.tris = np.ascontiguousarray(tris, np.int64)
+        self.across = edge_neighbours(self.tris)
         self.tree = AABBTree(X0, self.tris, owner=f"{cloth.name} skin")
         n = len(self.view.x)
         self.dv, self.s, self.n = np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3))
@@ -106,7 +108,7 @@ class _Projector:
         v = self.view
         tri, d, bary = self.tree.nearest(v.x, self.p.thickness + self.p.reach)
         vertex_normals(X, self.tris, self.vn)
-        signed_distance(v.x, tri, bary, d, X, self.tris, self.vn, self.s, self.n)
+        signed_distance(v.x, tri, bary, d, X, self.tris, self.across, self.vn, self.s, self.n)
         found = self.s[tri >= 0]
         if len(found):
             self.approach = max(self.approach, float(-found.min()))

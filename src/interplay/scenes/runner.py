@@ -43,7 +43,7 @@ class RunnerParams:
     clip: str = param("cmu_02_03_run.bvh", check=check_clip,
                       doc="a BVH clip in the mocap folder or a path; empty: keyframes")
     clearance: ClearanceParams = ClearanceParams()
-    skin: SurfaceParams = SurfaceParams(spacing=0.025)
+    skin: SurfaceParams = SurfaceParams()
     tee: Fit = Fit(spacing=0.016)
     pants: Fit = Fit(spacing=0.016, ease=0.025)
     contact: SkinContactParams = SkinContactParams()

@@ -147,7 +147,7 @@ class Garments(SpringNetwork):
         s, n = np.full(len(self.x), np.inf), np.zeros_like(self.x)
         vn = np.zeros_like(X)
         vertex_normals(X, skin.tris, vn)
-        signed_distance(self.x, tri, bary, d, X, skin.tris, vn, s, n)
+        signed_distance(self.x, tri, bary, d, X, skin.tris, skin.across, vn, s, n)
         depth = float(max(0.0, -s.min()))
         selfx = len(self._own.intersections())
         largest, share = self.stretch()
