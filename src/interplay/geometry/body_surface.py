@@ -22,11 +22,12 @@ Built once per body plan:
    smoothly at the joints and never cracks, as every vertex is one point moved by a convex
    combination of rigid motions.
 4. **Kept apart where limbs meet** (``contact_gap``): linear blending lets two limbs' skins
-   pass through each other where they touch (the inner thighs as the legs pass, the armpit as
-   an arm comes down). A vertex that lies within CONTACT_REACH of another limb's solid in the
-   A-pose is, once posed, kept at least ``contact_gap`` (or its A-pose distance, if nearer)
-   outside that solid, pushed out along the solid's gradient: soft tissue pressed flat
-   against its neighbour, both sides the same way, so the two skins meet without crossing.
+   pass through each other where they touch (the inner thighs as the legs pass). A vertex
+   that lies within CONTACT_REACH of the solid of another limb it is not joined to (a leg
+   and the other leg or an arm; not a leg and the pelvis) in the A-pose is, once posed,
+   kept at least ``contact_gap`` (or its A-pose distance, if nearer) outside that solid,
+   pushed out along the solid's gradient: soft tissue pressed flat against its neighbour,
+   both sides the same way, so the two skins meet without crossing.
 
 It works for any system with the RigidParts poses of the 17 segments (Figure, MocapFigure):
 ``pose(seg_pos, seg_rot)`` gives the world vertices. ``BodySurface.sdf`` is the A-pose body's
@@ -445,9 +446,17 @@ class BodySurface:
                           for i in range(len(LIMBS))], axis=1)
         limb = share.argmax(axis=1)
         d = segment_distances(v, self.solids, self.pos0, self.rot0)
+        # limbs joined at a joint (a leg and the pelvis, an arm and the torso) overlap at it
+        # by construction, and deeply when it bends (she sits: the thigh's top in the belly):
+        # their meeting is the blend's, not a contact
+        joined = np.eye(len(LIMBS), dtype=bool)
+        for s in self.plan:
+            if s.parent is not None:
+                a, b = limb_of[names.index(s.name)], limb_of[names.index(s.parent)]
+                joined[a, b] = joined[b, a] = True
         out = []
         for k in range(len(names)):
-            near = np.flatnonzero((limb != limb_of[k]) & (d[:, k] < CONTACT_REACH))
+            near = np.flatnonzero(~joined[limb, limb_of[k]] & (d[:, k] < CONTACT_REACH))
             if len(near):
                 out.append((k, near, np.minimum(self.params.contact_gap,
                                                 np.maximum(d[near, k], 0.0))))
