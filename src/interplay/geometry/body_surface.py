@@ -354,8 +354,11 @@ class BodySurface:
         v, t = marching_tetrahedra(field, lo, h)
         start, nbr = vertex_neighbours(t, len(v))
         v = self.project(v)
+        # a relaxation pass moves a vertex along the surface by a fraction of an edge: one
+        # Newton step brings it back to within a hair, and the last projection to the surface
         for _ in range(params.smoothing):
-            v = self.project(0.5 * v + 0.5 * umbrella(v, start, nbr))
+            v = self.project(0.5 * v + 0.5 * umbrella(v, start, nbr), iterations=1)
+        v = self.project(v)
         self.vertices0, self.triangles = v, t
         self._nbr = (start, nbr)
         self.weights = self._weights(v, start, nbr)
