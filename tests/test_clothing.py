@@ -76,10 +76,7 @@ def runner_skin(cleared_clip):
 
 def limb_of_triangles(skin):
     """Each skin triangle's limb (index into LIMBS): the one most of its corners belong to."""
-    names = [s.name for s in skin.plan]
-    limb = np.array([next(i for i, p in enumerate(LIMBS.values()) if n in p) for n in names])
-    share = np.stack([skin.weights[:, limb == i].sum(axis=1) for i in range(len(LIMBS))], 1)
-    corner = share.argmax(axis=1)[skin.triangles]
+    corner = skin.vertex_limbs()[skin.triangles]
     return np.array([np.bincount(c, minlength=len(LIMBS)).argmax() for c in corner])
 
 

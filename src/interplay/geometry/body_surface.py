@@ -195,19 +195,30 @@ def smooth_min(a, b, k):
     return np.minimum(a, b) - h * h * k / 4.0
 
 
+def segment_limbs(names) -> np.ndarray:
+    """(17,) the limb (index into LIMBS) each named segment belongs to."""
+    return np.array([next(i for i, parts in enumerate(LIMBS.values()) if n in parts)
+                     for n in names])
+
+
 def solid_distance(local, items) -> np.ndarray:
     """(n,) signed distance (m) of points in a segment's frame to the union of its solids."""
     return np.min([_solid_distance(local, it) for it in items], axis=0)
 
 
-def solid_gradient(local, items, eps: float = 1e-5) -> np.ndarray:
-    """(n,3) central-difference gradient of ``solid_distance`` (unit length off the surface)."""
-    g = np.empty_like(local)
+def central_gradient(f, p, eps: float) -> np.ndarray:
+    """(n,3) central-difference gradient of a field f(points (n,3)) -> (n,) at points p."""
+    g = np.empty_like(p)
     for a in range(3):
         d = np.zeros(3)
         d[a] = eps
-        g[:, a] = (solid_distance(local + d, items) - solid_distance(local - d, items)) / (2 * eps)
+        g[:, a] = (f(p + d) - f(p - d)) / (2 * eps)
     return g
+
+
+def solid_gradient(local, items, eps: float = 1e-5) -> np.ndarray:
+    """(n,3) gradient of ``solid_distance`` (unit length off the surface)."""
+    return central_gradient(lambda q: solid_distance(q, items), local, eps)
 
 
 def segment_distances(points, plan_solids, pos, rot) -> np.ndarray:
@@ -363,6 +374,13 @@ class BodySurface:
         self._nbr = (start, nbr)
         self.weights = self._weights(v, start, nbr)
         self.contacts = self._contacts(v) if params.contact_gap > 0 else []
+        # the vertices the push may move, and their neighbour lists, for the smoothing
+        # between pushes (every pose: only these, not the whole mesh)
+        self._watched = (np.unique(np.concatenate([idx for _, idx, _ in self.contacts]))
+                         if self.contacts else np.zeros(0, np.int64))
+        lists = [nbr[start[i]:start[i + 1]] for i in self._watched]
+        self._watched_nbr = (np.concatenate([[0], np.cumsum([len(n) for n in lists])]),
+                             np.concatenate(lists) if lists else np.zeros(0, np.int64))
 
     # --- geometry at the A-pose ------------------------------------------------------------------
     def _bounds(self):
@@ -388,13 +406,7 @@ class BodySurface:
 
     def gradient(self, points, eps: float = 1e-4) -> np.ndarray:
         """(n,3) central-difference gradient of ``sdf`` (about unit length outside)."""
-        p = np.asarray(points, float)
-        g = np.empty_like(p)
-        for a in range(3):
-            d = np.zeros(3)
-            d[a] = eps
-            g[:, a] = (self.sdf(p + d) - self.sdf(p - d)) / (2 * eps)
-        return g
+        return central_gradient(self.sdf, np.asarray(points, float), eps)
 
     def project(self, points, level: float = 0.0, iterations: int = 3) -> np.ndarray:
         """Points moved along the gradient onto the level set sdf = level (m) by Newton steps."""
@@ -443,11 +455,8 @@ class BodySurface:
         within CONTACT_REACH of segment k's solid in the A-pose, and the distance each keeps
         from it when posed (``contact_gap``, or its A-pose distance if nearer)."""
         names = [s.name for s in self.plan]
-        limb_of = np.array([next(i for i, parts in enumerate(LIMBS.values()) if n in parts)
-                            for n in names])
-        share = np.stack([self.weights[:, limb_of == i].sum(axis=1)
-                          for i in range(len(LIMBS))], axis=1)
-        limb = share.argmax(axis=1)
+        limb_of = segment_limbs(names)
+        limb = self.vertex_limbs()
         d = segment_distances(v, self.solids, self.pos0, self.rot0)
         # limbs joined at a joint (a leg and the pelvis, an arm and the torso) overlap at it
         # by construction, and deeply when it bends (she sits: the thigh's top in the belly):
@@ -465,16 +474,23 @@ class BodySurface:
                                                 np.maximum(d[near, k], 0.0))))
         return out
 
+    def vertex_limbs(self) -> np.ndarray:
+        """(n,) each vertex's limb (index into LIMBS): the one that carries most of its
+        weight."""
+        limb_of = segment_limbs([s.name for s in self.plan])
+        return np.stack([self.weights[:, limb_of == i].sum(axis=1)
+                         for i in range(len(LIMBS))], axis=1).argmax(axis=1)
+
     def _keep_apart(self, X, seg_pos, seg_rot) -> np.ndarray:
         """Posed vertices X (n,3) with each watched vertex pushed out of the other limb's solid
         to its least distance (``_contacts``); between pushes the watched vertices are
         smoothed, so a pushed patch bends into its neighbours instead of folding over them."""
         if not self.contacts:
             return X
-        watched = np.unique(np.concatenate([idx for _, idx, _ in self.contacts]))
+        w = self._watched
         for _ in range(CONTACT_PASSES):
             X = self._push(X, seg_pos, seg_rot)
-            X[watched] = 0.5 * X[watched] + 0.5 * umbrella(X, *self._nbr)[watched]
+            X[w] = 0.5 * X[w] + 0.5 * umbrella(X, *self._watched_nbr)
         return self._push(X, seg_pos, seg_rot)
 
     def _push(self, X, seg_pos, seg_rot) -> np.ndarray:

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
 from ..params import param
 from .body_surface import solid_distance, solid_gradient, solids
@@ -74,11 +75,11 @@ def surface_points(items, spacing: float = SAMPLE) -> np.ndarray:
 
 
 def _bounds(it):
+    """(low, high) corners (m) of a solid's bounding box: a cone's ends and radius, a box's or
+    an ellipsoid's centre and half sizes."""
     if it[0] == "cone":
         r = max(it[3], it[4])
         return np.minimum(it[1], it[2]) - r, np.maximum(it[1], it[2]) + r
-    if it[0] == "box":
-        return it[1] - it[2], it[1] + it[2]
     return it[1] - it[2], it[1] + it[2]
 
 
@@ -97,10 +98,14 @@ def forward(plan, root_pos, seg_rot) -> np.ndarray:
 
 
 def _turn(axis, angles) -> np.ndarray:
-    """(n,3,3) rotations by ``angles`` (n,) rad about unit ``axis`` (3,) (Rodrigues)."""
-    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
-                  [-axis[1], axis[0], 0.0]])
-    a = np.asarray(angles, float)[:, None, None]
+    """(n,3,3) rotations by ``angles`` (n,) rad about unit ``axis`` (3,), or about each of
+    ``axis`` (n,3) in turn (Rodrigues)."""
+    a = np.asarray(angles, float)
+    ax = np.broadcast_to(np.asarray(axis, float), a.shape + (3,))
+    K = np.zeros(a.shape + (3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -ax[:, 2], ax[:, 1], -ax[:, 0]
+    K = K - np.swapaxes(K, 1, 2)
+    a = a[:, None, None]
     return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * (K @ K)
 
 
@@ -111,7 +116,10 @@ class _Limbs:
         self.idx = {s.name: k for k, s in enumerate(plan)}
         self.solids = solids(plan)
         self.points = {}
+        tested = LEG["l"] + LEG["r"] + tuple(f"{side}_{n}" for side in "lr" for n in ARM_TESTED)
         for s in plan:
+            if s.name not in tested:
+                continue
             pts = surface_points(self.solids[self.idx[s.name]], spacing)
             if s.name.endswith("thigh"):  # below the crotch only
                 pts = pts[pts @ s.bone >= THIGH_TOP * float(s.bone @ s.bone)]
@@ -161,11 +169,9 @@ def _widen(angles, frames: int) -> np.ndarray:
     is at least the input there (each mean's window lies inside maxima that saw it)."""
     if frames <= 1:
         return angles
-    half = frames // 2
-    pad = np.pad(angles, half, mode="edge")
-    peak = np.array([pad[i:i + 2 * half + 1].max() for i in range(len(angles))])
-    pad = np.pad(peak, half, mode="edge")
-    return np.convolve(pad, np.ones(2 * half + 1) / (2 * half + 1), mode="valid")
+    width = 2 * (frames // 2) + 1
+    peak = maximum_filter1d(angles, width, mode="nearest")
+    return uniform_filter1d(peak, width, mode="nearest")
 
 
 def clear_limbs(plan, root_pos, seg_rot, frame_time: float,
@@ -199,7 +205,7 @@ def clear_limbs(plan, root_pos, seg_rot, frame_time: float,
     added["legs"] = _widen(need, frames)
     for side, sign in (("l", 1.0), ("r", -1.0)):
         ks = [idx[n] for n in LEG[side]]
-        T = _turn_each(rot[:, pelvis][:, :, 0], sign * added["legs"] / 2)
+        T = _turn(rot[:, pelvis][:, :, 0], sign * added["legs"] / 2)
         rot[:, ks] = np.einsum("fij,fkjl->fkil", T, rot[:, ks])
     pos = forward(plan, root_pos, rot)
     for side, sign in (("l", 1.0), ("r", -1.0)):
@@ -212,12 +218,8 @@ def clear_limbs(plan, root_pos, seg_rot, frame_time: float,
                                                   (pos[f, chain[0]], _turn(fwd, sign * a))),
                               params.arms, angles)
         added[f"{side}_arm"] = _widen(need, frames)
-        T = _turn_each(rot[:, torso][:, :, 0], sign * added[f"{side}_arm"])
+        T = _turn(rot[:, torso][:, :, 0], sign * added[f"{side}_arm"])
         rot[:, chain] = np.einsum("fij,fkjl->fkil", T, rot[:, chain])
         pos = forward(plan, root_pos, rot)
     return rot, added
 
-
-def _turn_each(axes, angles) -> np.ndarray:
-    """(F,3,3): a rotation by angles[f] about axes[f] (unit) for every frame."""
-    return np.array([_turn(a, [t])[0] for a, t in zip(axes, angles)])
