@@ -406,3 +406,31 @@ def test_default_run_bounces_ten_times(default_run):
     _, fig = default_run
     assert fig["bounces"] >= 10, fig
     assert fig["flight_height_variation"] < 0.10, fig
+
+
+def test_a_touch_just_after_takeoff_continues_the_stance():
+    """The recoiling bed may catch her toes a few ms after takeoff: the live record, like the
+    contact log's episodes (record_of, gaps under forcelog.GAP), counts one landing, not two,
+    so a search is not told she landed with a zero flight."""
+    from types import SimpleNamespace
+    from interplay.control.bounce_search import BounceRecord, Recorded
+    from interplay.coupling.forcelog import GAP
+
+    class Still:
+        def offsets(self, fig, s):
+            return np.zeros(3)
+    data = SimpleNamespace(xmat=np.eye(3).reshape(1, 9), ncon=0, subtree_angmom=np.zeros((1, 3)))
+    fig = SimpleNamespace(data=data, root=0, time=0.0, touched=np.zeros(1, bool))
+    rec = BounceRecord()
+    law = Recorded(Still(), rec)
+    # air, stance, 1 tick off (well under GAP), stance, off for good, then a real landing
+    ticks = [0] * 20 + [1] * 80 + [0] + [1] * 3 + [0] * 150 + [1] * 5
+    dt = 0.005
+    assert dt < GAP
+    for k, on in enumerate(ticks):
+        fig.time = k * dt
+        law.offsets(fig, {"com": np.array([0.0, 0.0, 2.0 - 0.001 * k]),
+                          "com_vel": np.zeros(3), "foot_contact": bool(on),
+                          "hand_contact": False})
+    assert [round(t, 3) for t, *_ in rec.landings] == [0.1, round(254 * dt, 3)]
+    assert len(rec.takeoffs) == 1 and round(rec.takeoffs[0][0], 3) == round(104 * dt, 3)

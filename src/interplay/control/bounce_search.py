@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..coupling.forcelog import GAP
 from .bounce import BOUNDS
 from .search import Search
 
@@ -66,7 +67,12 @@ class Recorded:
             fig.touched.any())
         if r._air:
             r._top = max(r._top, float(com[2]))
-            if touching:
+            if touching and r.takeoffs and fig.time - r.takeoffs[-1][0] < GAP:
+                # the recoiling bed caught her toes just after takeoff: the stance goes on
+                # (as in the contact log's episodes, record_of)
+                r.takeoffs.pop()
+                r._air = False
+            elif touching:
                 r.apexes.append(r._top)
                 r.landings.append((fig.time, float(com[0]), float(com[1]), float(com[2]),
                                    tilt))
