@@ -12,10 +12,13 @@ and L at touchdown, its range, and at takeoff (the first step in the air after).
 
 With ``--box``, instead of the gymnast a foot-sized box pressed into the bed by 1000 N, free
 and uncontrolled, on the same bed through the same contact (``planted_box``): the contact and
-bed alone.
+bed alone. With ``--tilt N_M ...`` the same box with each pitch torque (an ankle pressing the
+forefoot in): how far a foot tilts on the bed under an ankle's torque, and at what torque it
+capsizes onto its edge (``--load N ...``: the loads).
 
     PYTHONPATH=src python benchmarks/tramp_chatter.py [--duration 2.5] [--set KEY=VALUE ...]
-        [--strap-damping N_S_PER_M] [--sole N_PER_M N_S_PER_M] [--box] [--out out/chatter.json]
+        [--strap-damping N_S_PER_M] [--sole N_PER_M N_S_PER_M] [--box] [--tilt N_M ...] [--load N ...]
+        [--out out/chatter.json]
 """
 from __future__ import annotations
 
@@ -30,6 +33,7 @@ from interplay.geometry.anthropometry import SEGMENTS
 from interplay.geometry.trampoline import build_bed
 from interplay.interactions.part_contact import PartContact
 from interplay.kernels.contact import DAMPING, STIFFNESS
+from interplay.kernels.rigid import quat_to_matrix
 from interplay.params import apply
 from interplay.scenes import trampoline as T
 
@@ -140,13 +144,18 @@ def stances(t, f, L, pitch, dt: float) -> list[dict]:
     return out
 
 
-def planted_box(params, load: float = 1000.0, mass: float = 10.0, seconds: float = 3.0) -> dict:
+def planted_box(params, load: float = 1000.0, mass: float = 10.0, seconds: float = 3.0,
+                torque: float = 0.0) -> dict:
     """A foot-sized box (the figure's foot: 0.25 x 0.094 x 0.06 m) of ``mass`` (kg) pressed
     into the bed by ``load`` (N, as its weight: gravity load / mass, so the contact's
     constraint term sees it), free in all six degrees of freedom, through the same contact
     (``params.contact``) on the same bed (``params.bed``), stepped at ``params.coupling_dt``:
-    no controller, no figure. Returns the contact force's horizontal rms (N, about its mean,
-    along the box's length x and across it y) over the second half of the run."""
+    no controller, no figure. ``torque`` (N m) about the box's width (toes down: an ankle's
+    plantarflexion pressing the forefoot in) is ramped in over the first second. Returns the
+    contact force's horizontal rms (N, about its mean, along the box's length x and across it
+    y) and the box's tilt (rad, mean and rms over the second half of the run: past a few
+    tenths of a radian the box has capsized onto its edge) and depth below the bed's top
+    (m)."""
     from interplay.geometry.primitive import Primitive
     from interplay.systems.colliders import box_surface
     from interplay.systems.rigid import RigidBody
@@ -163,19 +172,27 @@ def planted_box(params, load: float = 1000.0, mass: float = 10.0, seconds: float
     contact.prepare(h)
     n = int(round(seconds / h))
     f = np.zeros((n, 3))
+    tilt = np.zeros(n)
     for k in range(n):
         box.clear_forces()
         net.clear_forces()
+        box.add_wrench(np.zeros(3), torque=(0.0, torque * min(1.0, k * h), 0.0))
         res = contact.exchange(True, True)
         net.advance(h, net.dt)
         if res is None:
             res = contact.complete(True)
         box.advance(h)
         f[k] = res[0]
+        R = quat_to_matrix(box.q)
+        tilt[k] = np.arctan2(-R[2, 0], R[0, 0])  # > 0: the box's +x end down
     late = f[n // 2:]
-    return {"load_N": load, "mass_kg": mass, "vertical_mean_N": round(float(late[:, 2].mean()), 1),
+    return {"load_N": load, "mass_kg": mass, "torque_N_m": torque,
+            "vertical_mean_N": round(float(late[:, 2].mean()), 1),
             "fx_rms_N": round(float(late[:, 0].std()), 1),
-            "fy_rms_N": round(float(late[:, 1].std()), 1)}
+            "fy_rms_N": round(float(late[:, 1].std()), 1),
+            "tilt_mean_rad": round(float(tilt[n // 2:].mean()), 4),
+            "tilt_rms_rad": round(float(tilt[n // 2:].std()), 4),
+            "depth_m": round(float(top - box.x[2]), 3)}
 
 
 def main(argv=None):
@@ -186,13 +203,20 @@ def main(argv=None):
     ap.add_argument("--sole", type=float, nargs=2, metavar=("N_PER_M", "N_S_PER_M"))
     ap.add_argument("--box", action="store_true",
                     help="a loaded foot-sized box on the bed instead of the gymnast")
+    ap.add_argument("--tilt", type=float, nargs="+", metavar="N_M",
+                    help="the loaded box with these pitch torques: its tilt on the bed")
+    ap.add_argument("--load", type=float, nargs="+", default=[1000.0], metavar="N",
+                    help="the box's loads (N), with --box or --tilt")
     ap.add_argument("--out", type=Path)
     a = ap.parse_args(argv)
     sets = dict(s.split("=", 1) for s in a.set)
     params = apply(T.TrampolineParams(), sets)
-    if a.box:
-        res = {"sets": sets, "box": planted_box(params)}
-        print(res)
+    if a.box or a.tilt:
+        runs = [planted_box(params, load, torque=tq) for load in a.load
+                for tq in (a.tilt or [0.0])]
+        res = {"sets": sets, "box": runs}
+        for r in runs:
+            print(r)
         if a.out:
             a.out.parent.mkdir(parents=True, exist_ok=True)
             a.out.write_text(json.dumps(res, indent=1))
