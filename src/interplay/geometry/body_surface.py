@@ -42,6 +42,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..params import param
 from .anthropometry import SEGMENTS, BodyParams, body_plan
+from .skinning import Skinning
 
 #: the body's limbs: a skin vertex belongs to the one that holds most of its weight
 LIMBS = {"trunk": ("pelvis", "torso", "head"),
@@ -373,6 +374,7 @@ class BodySurface:
         self.vertices0, self.triangles = v, t
         self._nbr = (start, nbr)
         self.weights = self._weights(v, start, nbr)
+        self.skin = Skinning(v, self.weights)
         self.contacts = self._contacts(v) if params.contact_gap > 0 else []
         # the vertices the push may move, and their neighbour lists, for the smoothing
         # between pushes (every pose: only these, not the whole mesh)
@@ -515,34 +517,23 @@ class BodySurface:
         b = np.asarray(seg_pos, float)[:k] - np.einsum("kij,kj->ki", A, self.pos0)
         return A, b
 
-    def pose(self, seg_pos, seg_rot, points=None) -> np.ndarray:
+    def pose(self, seg_pos, seg_rot) -> np.ndarray:
         """World vertices (n,3) m at the segments' poses (positions (17,3), rotations
-        (17,3,3)), limbs kept apart where they meet; ``points``: other A-pose points carried
-        by the weights alone (a garment)."""
-        A, b = self.transforms(seg_pos, seg_rot)
-        x0 = self.vertices0 if points is None else points
-        w = self.weights if points is None else self.weights_at(points)
-        out = np.zeros_like(x0)
-        for k in np.flatnonzero(w.any(axis=0)):
-            out += w[:, k, None] * (x0 @ A[k].T + b[k])
-        if points is None:
-            out = self._keep_apart(out, np.asarray(seg_pos, float), np.asarray(seg_rot, float))
-        return out
+        (17,3,3)), limbs kept apart where they meet."""
+        out = self.skin.positions(*self.transforms(seg_pos, seg_rot))
+        return self._keep_apart(out, np.asarray(seg_pos, float), np.asarray(seg_rot, float))
 
-    def weights_at(self, points) -> np.ndarray:
-        """Skinning weights of other A-pose points: those of their nearest skin vertex."""
+    def skinning(self, points) -> Skinning:
+        """Other A-pose points (a garment's) carried by the weights of their nearest skin
+        vertex."""
         from scipy.spatial import cKDTree
         _, j = cKDTree(self.vertices0).query(np.asarray(points, float))
-        return self.weights[j]
+        return Skinning(points, self.weights[j])
 
     def velocities(self, seg_pos, seg_rot, lin, ang, centres) -> np.ndarray:
         """(n,3) m/s of the skinned vertices for segment velocities (lin at ``centres``, ang)."""
         A, b = self.transforms(seg_pos, seg_rot)
-        out = np.zeros_like(self.vertices0)
-        for k in np.flatnonzero(self.weights.any(axis=0)):
-            xk = self.vertices0 @ A[k].T + b[k]
-            out += self.weights[:, k, None] * (lin[k] + np.cross(ang[k], xk - centres[k]))
-        return out
+        return self.skin.velocities(A, b, lin, ang, centres)
 
 
 def figure_surface(figure, params: SurfaceParams = SurfaceParams()) -> BodySurface:

@@ -57,7 +57,8 @@ class Garments(SpringNetwork):
         self.pinned = np.unique(np.concatenate(pins)) if pins else np.zeros(0, np.int64)
         self.fixed[:] = False
         self.fixed[self.pinned] = True
-        self._pin_weights = None
+        self._pin_skin = None  # geometry.skinning.Skinning of the pinned points, cut
+        self._cut_skin = None  # and of all points (made on first use)
         self._skin = None
         self.certificates: list = []
         self._own = None
@@ -67,28 +68,18 @@ class Garments(SpringNetwork):
         (positions (17,3), rotations (17,3,3)), their velocity the move over h (s)."""
         if not len(self.pinned):
             return
-        if self._pin_weights is None:
-            self._pin_weights = surface.weights_at(self.garment.vertices[self.pinned])
-        A, b = surface.transforms(seg_pos, seg_rot)
-        x0 = self.garment.vertices[self.pinned]
-        w = self._pin_weights
-        new = np.zeros_like(x0)
-        for k in np.flatnonzero(w.any(axis=0)):
-            new += w[:, k, None] * (x0 @ A[k].T + b[k])
+        if self._pin_skin is None:
+            self._pin_skin = surface.skinning(self.garment.vertices[self.pinned])
+        new = self._pin_skin.positions(*surface.transforms(seg_pos, seg_rot))
         self.v[self.pinned] = (new - self.x[self.pinned]) / h
         self.x[self.pinned] = new
 
     def skinned(self, surface, seg_pos, seg_rot) -> np.ndarray:
         """Where the skin's weights carry each garment point from the A-pose it was cut in
         (n,3) m: the garment's skinned reference."""
-        if getattr(self, "_weights", None) is None:
-            self._weights = surface.weights_at(self.garment.vertices)
-        A, b = surface.transforms(seg_pos, seg_rot)
-        x0, w = self.garment.vertices, self._weights
-        out = np.zeros_like(x0)
-        for k in np.flatnonzero(w.any(axis=0)):
-            out += w[:, k, None] * (x0 @ A[k].T + b[k])
-        return out
+        if self._cut_skin is None:
+            self._cut_skin = surface.skinning(self.garment.vertices)
+        return self._cut_skin.positions(*surface.transforms(seg_pos, seg_rot))
 
     def tether(self, surface, seg_pos, seg_rot, radius: float) -> int:
         """Keep every point within ``radius`` (m) of its skinned reference (the maximum
@@ -251,7 +242,7 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
         # the skin's weights at each (as a sleeve goes with its arm), then settled against
         # the skin; its rest lengths stay the cut ones, so what the carrying stretched
         # relaxes while it settles
-        net.x[:] = surface.pose(seg_pos, seg_rot, points=net.garment.vertices)
+        net.x[:] = net.skinned(surface, seg_pos, seg_rot)
         net.v[:] = 0.0
         pos0, rot0 = seg_pos, seg_rot
     else:
