@@ -198,18 +198,9 @@ def _nearest_one(p, i, radius, tree, tris, x, skip_incident, st):
             continue
         e = prim[node]
         if e < 0:
-            # the nearer child is searched first (pushed last), so the best distance shrinks
-            # early and more of the tree is pruned
-            a, b = left[node], right[node]
-            da, db = _box_dist2(p, lo, hi, a), _box_dist2(p, lo, hi, b)
-            if da < db:
-                a, b, da, db = b, a, db, da
-            if da <= best:
-                st[top] = a
-                top += 1
-            if db <= best:
-                st[top] = b
-                top += 1
+            st[top] = left[node]
+            st[top + 1] = right[node]
+            top += 2
             continue
         ia, ib, ic = tris[e, 0], tris[e, 1], tris[e, 2]
         if skip_incident and (ia == i or ib == i or ic == i):
