@@ -18,10 +18,9 @@ class Skinning:
     def __init__(self, x0, weights):
         self.x0 = np.ascontiguousarray(x0, float)
         w = np.asarray(weights, float)
-        rows, self.seg = np.nonzero(w)  # row-major: each point's segments in order
-        self.w = np.ascontiguousarray(w[rows, self.seg])
+        rows, seg = np.nonzero(w)  # row-major: each point's segments in order
+        self.seg, self.w = seg.astype(np.int64), np.ascontiguousarray(w[rows, seg])
         self.start = np.searchsorted(rows, np.arange(len(w) + 1)).astype(np.int64)
-        self.seg = self.seg.astype(np.int64)
 
     def positions(self, A, b) -> np.ndarray:
         """(n,3) m: the points at the segments' transforms x = A x0 + b (A (k,3,3), b (k,3))."""
