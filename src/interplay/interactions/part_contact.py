@@ -47,7 +47,11 @@ class PartContactParams:
     as a torso is: cloth draped over a sharp edge is folded over it, and thrown off it;
     stick: friction sticks through a tangential spring per touched point, kept from step to
     step (contact_law.sticking_friction), instead of the regularised law, whose viscous range
-    lets a foot pushed steadily along a soft network creep at v = F dt / m_point."""
+    lets a foot pushed steadily along a soft network creep at v = F dt / m_point; faces: the
+    parts' features (a box's corners, a capsule's ends, a sphere's centre) collide with the
+    network's triangles' faces as well as their edges, so a part narrower than a facet rests
+    on it instead of wedging between its edges (a foot on a trampoline's bed: without it the
+    bed's 0.12 m facets let a 1500 N foot through, docs/trampoline.md)."""
     thickness: float = param(0.004, "m", ge=0.0, le=0.2)
     friction: float = param(0.8, "-", ge=0.0, le=10.0)
     eps: float = param(0.01, "m/s", gt=0.0, le=10.0)
@@ -58,6 +62,7 @@ class PartContactParams:
     margin: float = param(0.01, "m", ge=0.0, le=1.0)
     rounding: float = param(0.0, "m", ge=0.0, le=0.2, doc="boxes' edges rounded by this radius")
     stick: bool = param(False, doc="friction sticks (a spring per touched point), no creep")
+    faces: bool = param(False, doc="the parts' corners and ends against the triangles' faces")
 
     def validated(self, owner: str) -> "PartContactParams":
         require_nonnegative(owner, "contact thickness", self.thickness, "m")
@@ -89,7 +94,8 @@ def _edges(triangles) -> np.ndarray:
 class PartContact(Interaction):
     """Rigid parts (primary: any system seen as BodiesView with primitives) against a spring
     network's elements (secondary: a PointsView). elements (s,2): point pairs to collide
-    ((p, p) for points); default the edges of its triangles, else its springs. extra:
+    ((p, p) for points); default the edges of its triangles, else its springs; with
+    ``params.faces`` its triangles' faces too. extra:
     ((part name, Primitive), ...) more primitives that parts have for this contact beside their
     own (a figure's neck, which its sphere of a head leaves out, for a noose round it); each
     pushes on its part. parts: the names of the parts whose own primitives collide (default
@@ -125,14 +131,22 @@ class PartContact(Interaction):
         self.view, self.net = view, net
         if elements is None:
             elements = _edges(net.triangles) if net.triangles is not None else net.segments
-        elems = np.ascontiguousarray(elements, dtype=np.int64).reshape(-1, 2)
-        if len(elems) and (elems.min() < 0 or elems.max() >= len(net.x)):
+        pairs = np.ascontiguousarray(elements, dtype=np.int64).reshape(-1, 2)
+        if len(pairs) and (pairs.min() < 0 or pairs.max() >= len(net.x)):
             raise ParameterError(f"interaction {name}: elements reference points outside "
                                  f"0..{len(net.x) - 1} of {network.name}")
+        if self.p.faces and net.triangles is None:
+            raise SceneError(f"interaction {name}: contact faces asked for, but {network.name} "
+                             "has no triangles; leave faces off")
+        faces = (np.asarray(net.triangles, np.int64).reshape(-1, 3) if self.p.faces
+                 else np.zeros((0, 3), np.int64))
+        elems = np.concatenate([np.column_stack([pairs, np.full(len(pairs), -1)]), faces])
         self.parts = self._parts(elems)
         rows = len(self.owner)
-        self._out = point_forces(2 * rows * len(elems))
-        self._touches = PC.touches(rows * len(elems), rows, len(net.x))
+        # every element a candidate of every part: one touch per segment, a face's per feature
+        most = int(sum(len(pairs) + len(faces) * PC.features(kind) for kind in self.parts.kind))
+        self._out = point_forces(3 * most)
+        self._touches = PC.touches(most, rows, len(net.x))
         self._wrenches = np.zeros((rows, 6))
         self._h = 0.0
         self.n_contacts = 0

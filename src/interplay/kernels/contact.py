@@ -104,7 +104,7 @@ def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrenc
     for q in range(6):
         wrench[q] = 0.0
     reach = radius + thickness
-    k = np.int64(0)  # not the literal 0: to_segment_ends would compile twice (0 and int64)
+    k = np.int64(0)  # not the literal 0: to_ends would compile twice (0 and int64)
     # scratch vectors, allocated once per call rather than per contact
     n = np.empty(3)
     r = np.empty(3)
@@ -163,25 +163,26 @@ def sphere_elements(ball, pts, pt_acc, elems, law, dt, out, with_jacobian, wrenc
         # Jacobians of the point forces: penalty along n; damping along n; friction in the
         # tangent plane (the law's slope where it is linear)
         visc = friction_slope(fn, vtn, mu, eps, inv_m, dt) if with_jacobian else 0.0
-        k = to_segment_ends(out, k, (ia, ib, wa, wb), F, n, vball, (cs, cd, visc),
-                            with_jacobian)
+        k = to_ends(out, k, (ia, ib if ib != ia else -1, -1), (wa, wb, 0.0), F, n, vball,
+                    (cs, cd, visc), with_jacobian)
     return k
 
 
 @njit(cache=True)
-def to_segment_ends(out, k, ends, F, n, vref, gains, with_jacobian):
-    """Write -F (N, the reaction of a contact force F on the other body) to a segment's ends
-    (ia, ib, wa, wb: point indices and barycentric weights; one entry when ia == ib) in the
+def to_ends(out, k, ends, w, F, n, vref, gains, with_jacobian):
+    """Write -F (N, the reaction of a contact force F on the other body) to an element's
+    points (ends: up to three point indices, -1 for none; w their barycentric weights) in the
     PointForces ``out`` from entry k, with the Jacobians when ``with_jacobian``: the penalty's
     c_s and the damping's c_d along the normal n, the friction's slope visc in the tangent
     plane (gains = (c_s, c_d, visc); contact_law.friction_slope), relative to the other
     body's velocity vref. Returns the next free entry."""
     out_idx, out_f, out_dfdx, out_dfdv, out_vref = out
-    ia, ib, wa, wb = ends
     cs, cd, visc = gains
-    for side in range(1 if ia == ib else 2):
-        p = ia if side == 0 else ib
-        wgt = wa if side == 0 else wb
+    for side in range(3):
+        p = ends[side]
+        if p < 0:
+            continue
+        wgt = w[side]
         out_idx[k] = p
         for a in range(3):
             out_f[k, a] = -wgt * F[a]

@@ -1,5 +1,5 @@
 """Rigid parts (spheres, capsules, boxes: a ball, a figure's segments) against a spring-mass
-network's segments or points, through the one contact law (SPEC 2.5).
+network's segments, points or faces, through the one contact law (SPEC 2.5).
 
 The parts move along predicted paths through a coupling step of h: centre of mass
 c0 + v t + a t^2 / 2 and rotation exp([w t]) R0, their own forces changing those paths by far
@@ -9,23 +9,22 @@ stiff network can integrate the contact inside its own substeps (kernels/subcycl
 each part receives the step's impulse: equal and opposite to what the points received, and
 momentum is conserved exactly.
 
-Geometry per (part, element): a sphere or capsule against a segment by closest points
-(Ericson 5.1.9); a box against a segment by minimising the box's signed distance along the
-segment (convex in the segment's parameter, so golden-section search finds the deepest point).
-A network's element is a segment (a spring, a triangle edge) or a point given as (p, p).
-Units SI; normals point from the element towards the part.
+Geometry per (part, element) in kernels/primitive_distance.py. A network's element is a
+segment (a spring, a triangle's edge) given as (a, b, -1), a point as (p, p, -1), or a
+triangle's face as (a, b, c), against which each of the part's features (a box's corners, a
+capsule's ends) is a contact of its own, its force shared by the face's three points by the
+foot's barycentric weights. Units SI; normals point from the element towards the part.
 """
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS, to_segment_ends
+from .contact import CONSTRAINT, DAMPING, EPS, FRICTION, STIFFNESS, THICKNESS, to_ends
 from .contact_law import friction_damping, normal_force, sliding_friction, sticking_friction
+from .primitive_distance import BOX, CAPSULE, SPHERE, closest, face_feature, features
 
-SPHERE, CAPSULE, BOX = 0, 1, 2
 KINDS = {"sphere": SPHERE, "capsule": CAPSULE, "box": BOX}
-GOLDEN_ITERATIONS = 14  # shrinks the bracket to 0.618^14 ~ 1e-3 of the segment's length
 
 
 class Parts(NamedTuple):
@@ -40,8 +39,8 @@ class Parts(NamedTuple):
     Motion at the step's start: centres (k,3) m, rotations (k,3,3) part to world, velocities
     (k,3) m/s, spins (k,3) rad/s, accels (k,3) m/s^2; masses (k,) kg; law (k,6) each part's
     contact law (kernels/contact.py; STIFFNESS, DAMPING < 0: from the pair's mass, resolving
-    a penetration over ``steps`` substeps, critically damped). elems (s,2) the network's
-    elements; start (k+1,), cand (c,) candidate elements of each part (``candidates``).
+    a penetration over ``steps`` substeps, critically damped). elems (s,3) the network's
+    elements (module docstring); start (k+1,), cand (c,) candidate elements of each part (``candidates``).
     Out: impulses (k,7) impulse (N s), angular impulse about the centre of mass (N m s) and
     peak force (N) per part over the step; peak (1,) the largest total force (N) of any
     substep; received (3,) the impulse (N s) the network's points received (minus the parts'
@@ -139,13 +138,7 @@ def candidates(parts, x, v, h, margin):
         if far:
             continue
         for e in range(elems.shape[0]):
-            a, b = elems[e, 0], elems[e, 1]
-            hit = True
-            for r in range(3):
-                if hi[r] < min(x[a, r], x[b, r]) or lo[r] > max(x[a, r], x[b, r]):
-                    hit = False
-                    break
-            if hit:
+            if _meets(x, elems[e], lo, hi, 0.0):
                 cand[k] = e
                 k += 1
     start[parts.kind.shape[0]] = k
@@ -180,167 +173,17 @@ def pose_at(parts, j, tau, c, R):
         R[2, b] = E20 * R0[0, b] + E21 * R0[1, b] + E22 * R0[2, b]
 
 
-@njit(cache=True, inline="always")
-def _local_sd(l0, l1, l2, h0, h1, h2):
-    """Signed distance (m) of a point (l0, l1, l2) in a box's frame from the box of half
-    extents h0, h1, h2 centred there."""
-    q0, q1, q2 = abs(l0) - h0, abs(l1) - h1, abs(l2) - h2
-    if q0 > 0.0 or q1 > 0.0 or q2 > 0.0:
-        e0, e1, e2 = max(q0, 0.0), max(q1, 0.0), max(q2, 0.0)
-        return np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-    return max(q0, max(q1, q2))
-
-
-@njit(cache=True)
-def _box_sd(C, R, h0, h1, h2, px, py, pz, g):
-    """Signed distance (m) of point p from a box (centre C, rotation R, half extents h0, h1,
-    h2) and the outward unit normal there, in the world, into g."""
-    dx, dy, dz = px - C[0], py - C[1], pz - C[2]
-    l0 = R[0, 0] * dx + R[1, 0] * dy + R[2, 0] * dz
-    l1 = R[0, 1] * dx + R[1, 1] * dy + R[2, 1] * dz
-    l2 = R[0, 2] * dx + R[1, 2] * dy + R[2, 2] * dz
-    q0, q1, q2 = abs(l0) - h0, abs(l1) - h1, abs(l2) - h2
-    if q0 > 0.0 or q1 > 0.0 or q2 > 0.0:
-        e0, e1, e2 = max(q0, 0.0), max(q1, 0.0), max(q2, 0.0)
-        d = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-        u0 = (e0 if l0 >= 0.0 else -e0) / d
-        u1 = (e1 if l1 >= 0.0 else -e1) / d
-        u2 = (e2 if l2 >= 0.0 else -e2) / d
-    else:  # inside: out through the nearest face
-        d = max(q0, max(q1, q2))
-        u0 = (1.0 if l0 >= 0.0 else -1.0) if d == q0 else 0.0
-        u1 = (1.0 if l1 >= 0.0 else -1.0) if (d == q1 and d != q0) else 0.0
-        u2 = (1.0 if l2 >= 0.0 else -1.0) if (d == q2 and d != q0 and d != q1) else 0.0
-    for r in range(3):
-        g[r] = R[r, 0] * u0 + R[r, 1] * u1 + R[r, 2] * u2
-    return d
-
-
-@njit(cache=True, inline="always")
-def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
-    """Deepest approach of a part's primitive (kind, p, q, size as in Parts; the part at
-    centre c, rotation R) to element ia-ib: returns (the element's parameter t in [0,1],
-    signed gap s: distance from the part's surface, negative inside); writes the element's
-    contact point X, the part's surface point P and the unit normal n (element towards
-    part). A, B are scratch (3,)."""
-    for r in range(3):
-        A[r] = c[r] + R[r, 0] * p[0] + R[r, 1] * p[1] + R[r, 2] * p[2]
-    xa, xb = x[ia], x[ib]
-    if kind == BOX:
-        # the element in the box's frame: the signed distance along it is then a cheap
-        # function of t, convex, minimised by golden-section search
-        ax, ay, az = xa[0] - A[0], xa[1] - A[1], xa[2] - A[2]
-        a0 = R[0, 0] * ax + R[1, 0] * ay + R[2, 0] * az
-        a1 = R[0, 1] * ax + R[1, 1] * ay + R[2, 1] * az
-        a2 = R[0, 2] * ax + R[1, 2] * ay + R[2, 2] * az
-        bx, by, bz = xb[0] - A[0], xb[1] - A[1], xb[2] - A[2]
-        e0 = R[0, 0] * bx + R[1, 0] * by + R[2, 0] * bz - a0
-        e1 = R[0, 1] * bx + R[1, 1] * by + R[2, 1] * bz - a1
-        e2 = R[0, 2] * bx + R[1, 2] * by + R[2, 2] * bz - a2
-        # a rounded box is the inner box (half extents less the rounding) grown by the
-        # rounding: its signed distance the inner box's less the rounding, the same normal
-        rnd = q[0]
-        h0, h1, h2 = size[0] - rnd, size[1] - rnd, size[2] - rnd
-        t = 0.0
-        if ia != ib:
-            lo, hi = 0.0, 1.0
-            gr = 0.6180339887498949
-            t1, t2 = 1.0 - gr, gr
-            f1 = _local_sd(a0 + t1 * e0, a1 + t1 * e1, a2 + t1 * e2, h0, h1, h2)
-            f2 = _local_sd(a0 + t2 * e0, a1 + t2 * e1, a2 + t2 * e2, h0, h1, h2)
-            for _ in range(GOLDEN_ITERATIONS):
-                if f1 <= f2:
-                    hi, t2, f2 = t2, t1, f1
-                    t1 = hi - gr * (hi - lo)
-                    f1 = _local_sd(a0 + t1 * e0, a1 + t1 * e1, a2 + t1 * e2, h0, h1, h2)
-                else:
-                    lo, t1, f1 = t1, t2, f2
-                    t2 = lo + gr * (hi - lo)
-                    f2 = _local_sd(a0 + t2 * e0, a1 + t2 * e1, a2 + t2 * e2, h0, h1, h2)
-            # a convex function's minimum may sit at an end of the segment
-            t = 0.5 * (lo + hi)
-            best = _local_sd(a0 + t * e0, a1 + t * e1, a2 + t * e2, h0, h1, h2)
-            f0 = _local_sd(a0, a1, a2, h0, h1, h2)
-            if f0 < best:
-                t, best = 0.0, f0
-            fe = _local_sd(a0 + e0, a1 + e1, a2 + e2, h0, h1, h2)
-            if fe < best:
-                t = 1.0
-        for r in range(3):
-            X[r] = xa[r] + t * (xb[r] - xa[r])
-        s = _box_sd(A, R, h0, h1, h2, X[0], X[1], X[2], n) - rnd
-        for r in range(3):
-            P[r] = X[r] - s * n[r]  # the box's surface point nearest X
-            n[r] = -n[r]  # outward from the box points at the element: flip to element -> part
-        return t, s
-    radius = size[0]
-    if kind == CAPSULE:
-        for r in range(3):
-            B[r] = c[r] + R[r, 0] * q[0] + R[r, 1] * q[1] + R[r, 2] * q[2]
-        sa, t = _segments(A, B, xa, xb)
-        for r in range(3):
-            A[r] += sa * (B[r] - A[r])  # the axis point nearest the element
-    else:
-        ex, ey, ez = xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]
-        L2 = ex * ex + ey * ey + ez * ez
-        t = 0.0 if L2 <= 0.0 else min(1.0, max(0.0, ((A[0] - xa[0]) * ex + (A[1] - xa[1]) * ey
-                                                     + (A[2] - xa[2]) * ez) / L2))
-    d2 = 0.0
-    for r in range(3):
-        X[r] = xa[r] + t * (xb[r] - xa[r])
-        n[r] = A[r] - X[r]
-        d2 += n[r] * n[r]
-    d = np.sqrt(d2)
-    if d <= 0.0:  # the element passes through the axis: push along +z (does not happen at rest)
-        n[0], n[1], n[2] = 0.0, 0.0, 1.0
-    else:
-        for r in range(3):
-            n[r] /= d
-    for r in range(3):
-        P[r] = A[r] - radius * n[r]
-    return t, d - radius
-
-
-@njit(cache=True, inline="always")
-def _segments(p1, q1, p2, q2):
-    """Parameters (s, t) of the closest points of segments p1-q1 and p2-q2 (Ericson 5.1.9,
-    scalar: no temporaries)."""
-    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
-    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
-    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
-    a = d1x * d1x + d1y * d1y + d1z * d1z
-    e = d2x * d2x + d2y * d2y + d2z * d2z
-    f = d2x * rx + d2y * ry + d2z * rz
-    tiny = 1e-30
-    if a <= tiny and e <= tiny:
-        return 0.0, 0.0
-    if a <= tiny:
-        return 0.0, min(1.0, max(0.0, f / e))
-    c = d1x * rx + d1y * ry + d1z * rz
-    if e <= tiny:
-        return min(1.0, max(0.0, -c / a)), 0.0
-    b = d1x * d2x + d1y * d2y + d1z * d2z
-    den = a * e - b * b
-    s = min(1.0, max(0.0, (b * f - c * e) / den)) if den > 1e-14 * a * e else 0.0
-    t = (b * s + f) / e
-    if t < 0.0:
-        return min(1.0, max(0.0, -c / a)), 0.0
-    if t > 1.0:
-        return min(1.0, max(0.0, (b - c) / a)), 1.0
-    return s, t
-
-
 class Touches(NamedTuple):
-    """Scratch for one substep's contacts (capacity c, the step's candidates): part (c,),
-    element ends ia, ib (c,), parameter t (c,), penetration pen (c,) m, normal n (c,3)
-    (element towards part), part surface point P (c,3) m and its velocity vp (c,3) m/s;
-    per part its predicted centre of mass c (k,3) m at the substep; per network point the
-    summed closest-point weight share (n,) of its contacts (zero between substeps); tau (1,)
-    s the substep's time into the step."""
+    """Scratch for one substep's contacts (capacity c: ``capacity`` of the step's
+    candidates): part (c,), the element's points ends (c,3) (-1: none; a segment has two, a
+    point one, a face three) and the contact point's weights on them w (c,3), penetration pen
+    (c,) m, normal n (c,3) (element towards part), part surface point P (c,3) m and its
+    velocity vp (c,3) m/s; per part its predicted centre of mass c (k,3) m at the substep; per
+    network point the summed weight share (n,) of its contacts (zero between substeps); tau
+    (1,) s the substep's time into the step."""
     part: np.ndarray
-    ia: np.ndarray
-    ib: np.ndarray
-    t: np.ndarray
+    ends: np.ndarray
+    w: np.ndarray
     pen: np.ndarray
     n: np.ndarray
     P: np.ndarray
@@ -352,20 +195,64 @@ class Touches(NamedTuple):
 
 def touches(capacity: int, parts: int, points: int) -> Touches:
     """Empty Touches for up to ``capacity`` contacts of ``parts`` parts on ``points`` points."""
-    return Touches(np.zeros(capacity, np.int64), np.zeros(capacity, np.int64),
-                   np.zeros(capacity, np.int64), np.zeros(capacity), np.zeros(capacity),
-                   np.zeros((capacity, 3)), np.zeros((capacity, 3)), np.zeros((capacity, 3)),
-                   np.zeros((parts, 3)), np.zeros(points), np.zeros(1))
+    return Touches(np.zeros(capacity, np.int64), np.zeros((capacity, 3), np.int64),
+                   np.zeros((capacity, 3)), np.zeros(capacity), np.zeros((capacity, 3)),
+                   np.zeros((capacity, 3)), np.zeros((capacity, 3)), np.zeros((parts, 3)),
+                   np.zeros(points), np.zeros(1))
+
+
+@njit(cache=True)
+def capacity(parts):
+    """The most touches the found candidates can give in one substep: one per segment or
+    point, one per feature of the part (primitive_distance.features) per face."""
+    total = 0
+    for j in range(parts.kind.shape[0]):
+        per_face = features(parts.kind[j])
+        for e in range(parts.start[j], parts.start[j + 1]):
+            total += 1 if parts.elems[parts.cand[e], 2] < 0 else per_face
+    return total
+
+
+@njit(cache=True, inline="always")
+def _meets(x, el, lo, hi, pad):
+    """Does the box of element el's points (-1: none) meet the box lo-hi grown by pad (m)?"""
+    for r in range(3):
+        emin, emax = x[el[0], r], x[el[0], r]
+        for s in range(1, 3):
+            if el[s] >= 0:
+                emin = min(emin, x[el[s], r])
+                emax = max(emax, x[el[s], r])
+        if hi[r] + pad < emin or lo[r] - pad > emax:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _record(tc, cnt, j, pen, n, P, c, lin, acc, w, tau):
+    """Touch cnt of part j (its ends and weights already in tc.ends / tc.w): penetration pen
+    (m), normal n, surface point P, and the part's surface velocity there, v + a tau + w x r;
+    adds the weights to the points' shares."""
+    tc.part[cnt], tc.pen[cnt] = j, pen
+    rx, ry, rz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
+    for r in range(3):
+        tc.n[cnt, r] = n[r]
+        tc.P[cnt, r] = P[r]
+        if tc.ends[cnt, r] >= 0:
+            tc.share[tc.ends[cnt, r]] += tc.w[cnt, r]
+    tc.vp[cnt, 0] = lin[0] + acc[0] * tau + w[1] * rz - w[2] * ry
+    tc.vp[cnt, 1] = lin[1] + acc[1] * tau + w[2] * rx - w[0] * rz
+    tc.vp[cnt, 2] = lin[2] + acc[2] * tau + w[0] * ry - w[1] * rx
 
 
 @njit(cache=True)
 def find_touches(parts, tau, x, tc):
     """Pass 1 at tau (s) into the step: every candidate element within its part's contact
-    skin, into the Touches ``tc``, and each touched point's summed weight (1 - t at ia, t at
-    ib) into tc.share. Returns the count."""
+    skin (a face: each of the part's features over it), into the Touches ``tc``, and each
+    touched point's summed weight into tc.share. Returns the count."""
     R = np.empty((3, 3))
     lo, hi = np.empty(3), np.empty(3)
-    A, B, X, P, n = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    A, B, X, P, n, bary = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+                           np.empty(3))
     cand, elems = parts.cand, parts.elems
     tc.tau[0] = tau
     cnt = 0
@@ -379,33 +266,30 @@ def find_touches(parts, tau, x, tc):
         kind, pj, qj, size = parts.kind[j], parts.p[j], parts.q[j], parts.size[j]
         w, lin, acc = parts.spins[j], parts.velocities[j], parts.accels[j]
         for e in range(parts.start[j], parts.start[j + 1]):
-            ia, ib = elems[cand[e], 0], elems[cand[e], 1]
-            if (hi[0] + thickness < min(x[ia, 0], x[ib, 0])
-                    or lo[0] - thickness > max(x[ia, 0], x[ib, 0])
-                    or hi[1] + thickness < min(x[ia, 1], x[ib, 1])
-                    or lo[1] - thickness > max(x[ia, 1], x[ib, 1])
-                    or hi[2] + thickness < min(x[ia, 2], x[ib, 2])
-                    or lo[2] - thickness > max(x[ia, 2], x[ib, 2])):
+            el = elems[cand[e]]
+            if not _meets(x, el, lo, hi, thickness):
                 continue  # the element's box misses the primitive's: no contact this substep
-            t, gap = closest(kind, pj, qj, size, c, R, x, ia, ib, A, B, X, P, n)
-            pen = thickness - gap
-            if pen <= 0.0:
+            ia, ib, ic = el[0], el[1], el[2]
+            if ic < 0:  # a segment, or a point (ia == ib)
+                t, gap = closest(kind, pj, qj, size, c, R, x, ia, ib, A, B, X, P, n)
+                pen = thickness - gap
+                if pen <= 0.0:
+                    continue
+                tc.ends[cnt, 0], tc.w[cnt, 0] = ia, 1.0 - t if ib != ia else 1.0
+                tc.ends[cnt, 1], tc.w[cnt, 1] = (ib, t) if ib != ia else (-1, 0.0)
+                tc.ends[cnt, 2], tc.w[cnt, 2] = -1, 0.0
+                _record(tc, cnt, j, pen, n, P, c, lin, acc, w, tau)
+                cnt += 1
                 continue
-            tc.part[cnt], tc.ia[cnt], tc.ib[cnt], tc.t[cnt], tc.pen[cnt] = j, ia, ib, t, pen
-            rx, ry, rz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
-            for r in range(3):
-                tc.n[cnt, r] = n[r]
-                tc.P[cnt, r] = P[r]
-            # the part's surface velocity at P: v + a tau + w x r
-            tc.vp[cnt, 0] = lin[0] + acc[0] * tau + w[1] * rz - w[2] * ry
-            tc.vp[cnt, 1] = lin[1] + acc[1] * tau + w[2] * rx - w[0] * rz
-            tc.vp[cnt, 2] = lin[2] + acc[2] * tau + w[0] * ry - w[1] * rx
-            if ia == ib:
-                tc.share[ia] += 1.0
-            else:
-                tc.share[ia] += 1.0 - t
-                tc.share[ib] += t
-            cnt += 1
+            for f in range(features(kind)):
+                gap = face_feature(kind, pj, qj, size, c, R, f, x, ia, ib, ic, X, P, n, bary)
+                pen = thickness - gap
+                if pen <= 0.0:
+                    continue
+                for s in range(3):
+                    tc.ends[cnt, s], tc.w[cnt, s] = el[s], bary[s]
+                _record(tc, cnt, j, pen, n, P, c, lin, acc, w, tau)
+                cnt += 1
     return cnt
 
 
@@ -433,22 +317,28 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
     clock = parts.clock[0] + 1
     parts.clock[0] = clock
     spring, ft_stick, vs = np.empty(3), np.empty(3), np.empty(3)
-    k = np.int64(0)  # not the literal 0: to_segment_ends would compile twice (0 and int64)
+    k = np.int64(0)  # not the literal 0: to_ends would compile twice (0 and int64)
     for i in range(cnt):
-        j, ia, ib, t = tc.part[i], tc.ia[i], tc.ib[i], tc.t[i]
+        j, ends, w = tc.part[i], tc.ends[i], tc.w[i]
         law = parts.law[j]
         mu, eps = law[FRICTION], law[EPS]
-        wa, wb = (1.0, 0.0) if ia == ib else (1.0 - t, t)
         n = tc.n[i]
         vn = 0.0
         an = 0.0
+        inv_m = 1.0 / parts.masses[j]
         for r in range(3):
-            vrel[r] = tc.vp[i, r] - (wa * v[ia, r] + wb * v[ib, r])
+            vrel[r] = tc.vp[i, r]
+            an += parts.accels[j, r] * n[r]
+        for s in range(3):
+            p = ends[s]
+            if p < 0:
+                continue
+            inv_m += w[s] * tc.share[p] / m[p]
+            for r in range(3):
+                vrel[r] -= w[s] * v[p, r]
+                an -= w[s] * pt_acc[p, r] * n[r]
+        for r in range(3):
             vn += vrel[r] * n[r]
-            an += (parts.accels[j, r] - (wa * pt_acc[ia, r] + wb * pt_acc[ib, r])) * n[r]
-        inv_m = 1.0 / parts.masses[j] + wa * tc.share[ia] / m[ia]
-        if ib != ia:
-            inv_m += wb * tc.share[ib] / m[ib]
         meff = 1.0 / inv_m
         cs = law[STIFFNESS] if law[STIFFNESS] >= 0.0 else meff * omega * omega
         cd = law[DAMPING] if law[DAMPING] >= 0.0 else 2.0 * meff * omega
@@ -470,14 +360,15 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
                 an_t += parts.accels[j, r] * n[r]
             for r in range(3):
                 vs[r] = vt[r] - (parts.accels[j, r] - an_t * n[r]) * tc.tau[0]
-            _gather(parts, j, ia, ib, wa, wb, clock, spring)
+            _gather(parts, j, ends, w, clock, spring)
             _, visc = sticking_friction(n, vs, fn, cs, cd, mu, eps, meff, dt, spring, ft_stick)
             for r in range(3):
                 F[r] = fn * n[r] + ft_stick[r]
-                parts.sums[j, ia, r] += wa * spring[r]
-                parts.sums[j, ib, r] += wb * spring[r]
-            parts.weights[j, ia] += wa
-            parts.weights[j, ib] += wb
+            for s in range(3):
+                if ends[s] >= 0:
+                    for r in range(3):
+                        parts.sums[j, ends[s], r] += w[s] * spring[r]
+                    parts.weights[j, ends[s]] += w[s]
         else:
             ft = -sliding_friction(fn, vtn, mu, eps, inv_m, dt) / vtn if vtn > 0.0 else 0.0
             for r in range(3):
@@ -491,33 +382,33 @@ def touch_forces(parts, tc, cnt, pts, pt_acc, dt, out, with_jacobian, wrenches):
         wrenches[j, 3] += ry * F[2] - rz * F[1]
         wrenches[j, 4] += rz * F[0] - rx * F[2]
         wrenches[j, 5] += rx * F[1] - ry * F[0]
-        k = to_segment_ends(out, k, (ia, ib, wa, wb), F, n, tc.vp[i], (cs, cd, visc),
-                            with_jacobian)
+        k = to_ends(out, k, ends, w, F, n, tc.vp[i], (cs, cd, visc), with_jacobian)
     for i in range(cnt):
-        tc.share[tc.ia[i]] = 0.0
-        tc.share[tc.ib[i]] = 0.0
-        if stick:
-            _keep(parts, tc.part[i], tc.ia[i], clock)
-            _keep(parts, tc.part[i], tc.ib[i], clock)
+        for s in range(3):
+            p = tc.ends[i, s]
+            if p >= 0:
+                tc.share[p] = 0.0
+                if stick:
+                    _keep(parts, tc.part[i], p, clock)
     return k
 
 
 @njit(cache=True, inline="always")
-def _gather(parts, j, ia, ib, wa, wb, clock, spring):
+def _gather(parts, j, ends, w, clock, spring):
     """A contact's tangential spring (m) into ``spring``: the mean of its ends' stretches on
-    part j, weighted wa, wb (ib == ia: one point), over the ends held at the previous call
+    part j, weighted w (ends < 0 unused), over the ends held at the previous call
     (an edge sliding in under a foot takes on the stretch of its end already there: counted
     as none, it would pull the contact's spring down at every edge that comes in, and the
     foot creep); none held: no stretch."""
     for r in range(3):
         spring[r] = 0.0
     held = 0.0
-    for side in range(1 if ia == ib else 2):
-        p, w = (ia, wa) if side == 0 else (ib, wb)
-        if parts.stamp[j, p] == clock - 1:
-            held += w
+    for s in range(3):
+        p = ends[s]
+        if p >= 0 and parts.stamp[j, p] == clock - 1:
+            held += w[s]
             for r in range(3):
-                spring[r] += w * parts.stretch[j, p, r]
+                spring[r] += w[s] * parts.stretch[j, p, r]
     if held > 0.0:
         for r in range(3):
             spring[r] /= held

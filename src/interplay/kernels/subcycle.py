@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .contact import Sphere, sphere_elements, THICKNESS
-from .part_contact import Touches, find_touches, touch_forces
+from .part_contact import Touches, capacity, find_touches, touch_forces
 from .springs import (Bodies, Load, PointForces, copy_load, copy_rows, implicit_step,
                       implicit_step_with_bodies, network_forces, symplectic_update)
 
@@ -245,16 +245,16 @@ def _part_work(net, load, parts):
     x = net.pts.x
     n = x.shape[0]
     k_parts = parts.impulses.shape[0]
-    nc = parts.start[k_parts]  # the step's candidates: at most 2 point entries each
+    nc = capacity(parts)  # the step's touches at most: at most 3 point entries each
     parts.impulses[:, :] = 0.0
     parts.peak[0] = 0.0
     parts.received[:] = 0.0
-    return (PointForces(np.zeros(2 * nc, dtype=np.int64), np.zeros((2 * nc, 3)),
-                        np.zeros((2 * nc, 3, 3)), np.zeros((2 * nc, 3, 3)),
-                        np.zeros((2 * nc, 3))),
-            Touches(np.zeros(nc, np.int64), np.zeros(nc, np.int64), np.zeros(nc, np.int64),
-                    np.zeros(nc), np.zeros(nc), np.zeros((nc, 3)), np.zeros((nc, 3)),
-                    np.zeros((nc, 3)), np.zeros((k_parts, 3)), np.zeros(n), np.zeros(1)),
+    return (PointForces(np.zeros(3 * nc, dtype=np.int64), np.zeros((3 * nc, 3)),
+                        np.zeros((3 * nc, 3, 3)), np.zeros((3 * nc, 3, 3)),
+                        np.zeros((3 * nc, 3))),
+            Touches(np.zeros(nc, np.int64), np.zeros((nc, 3), np.int64), np.zeros((nc, 3)),
+                    np.zeros(nc), np.zeros((nc, 3)), np.zeros((nc, 3)), np.zeros((nc, 3)),
+                    np.zeros((k_parts, 3)), np.zeros(n), np.zeros(1)),
             np.zeros((k_parts, 6)),
             Load(np.empty_like(load.f), np.empty_like(load.kext), np.empty_like(load.dext),
                  np.empty_like(load.kvref)),
