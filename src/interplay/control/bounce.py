@@ -69,29 +69,30 @@ class BounceParams:
     of the body's pitch spin the arms take in the air by circling (forward against a
     backward spin), so the trunk lands upright, a trampolinist's correction."""
     knee_land: float = param(
-        0.14445817435485553, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
-    lean: float = param(-0.0488264489650417, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
-    trunk: float = param(-0.03840802227306958, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
+        0.1, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
+    lean: float = param(0.013067336197741832, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
+    trunk: float = param(-0.029034583135383374, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
     leg_omega: float = param(
-        12.8848547499585, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
+        13.599290972358455, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
     ankle_share: float = param(
-        0.7741162175548496, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
-    thrust_delay: float = param(0.16237907246390273, "s", ge=0.0, le=2.0, doc="after touchdown")
-    power: float = param(0.5841121639613117, "-", gt=0.0, le=5.0, doc="the extension's speed")
-    ankle_push: float = param(0.35920869840470787, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
-    arm_swing: float = param(3.1, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
+        0.6594812445410662, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
+    thrust_delay: float = param(0.15977712366621083, "s", ge=0.0, le=2.0, doc="after touchdown")
+    power: float = param(0.9211436989186281, "-", gt=0.0, le=5.0, doc="the extension's speed")
+    ankle_push: float = param(0.13960834318473667, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
+    arm_swing: float = param(
+        3.031584092430814, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
     arm_land: float = param(
-        0.003616482133918858, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
-    k_speed: float = param(0.6, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+        0.900846141901059, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
+    k_speed: float = param(0.4088016267910487, "s", ge=0.0, le=5.0, doc="foot placement on speed")
     k_place: float = param(
-        0.46001672902920826, "-", ge=0.0, le=5.0, doc="foot placement on offset")
-    k_lead: float = param(4.970550615473857, "rad/m", ge=0.0, le=50.0)
-    k_drift: float = param(0.08162544824107555, "rad s/m", ge=0.0, le=20.0)
-    k_spin: float = param(0.0164970699297445, "rad s/(kg m^2)", ge=0.0, le=1.0)
-    k_attitude: float = param(0.04171894873496466, "-", ge=0.0, le=3.0)
-    k_turn: float = param(0.003324037518460548, "m s/(kg m^2)", ge=-1.0, le=1.0)
-    k_hip_spin: float = param(-0.06, "rad s/(kg m^2)", ge=-1.0, le=1.0)
-    k_arms: float = param(0.05108273094290473, "-", ge=0.0, le=5.0)
+        0.44660764515605406, "-", ge=0.0, le=5.0, doc="foot placement on offset")
+    k_lead: float = param(2.9457184109697683, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.11856835722415564, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.025740446690318424, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.057985445297466166, "-", ge=0.0, le=3.0)
+    k_turn: float = param(0.0017583143699759665, "m s/(kg m^2)", ge=-1.0, le=1.0)
+    k_hip_spin: float = param(-0.048651496501968365, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    k_arms: float = param(0.23585735263605434, "-", ge=0.0, le=5.0)
 
     def validated(self) -> "BounceParams":
         for f in fields(self):

@@ -175,6 +175,30 @@ HAND_START = {"knee_land": 0.2, "lean": 0.0, "trunk": 0.0, "leg_omega": 12.0,
               "k_hip_spin": -0.03, "k_arms": 0.0, "ankle_share": 1.0}
 
 
+#: the defaults of BounceParams until 2026-12-06: the second edges-only search's best, and the
+#: start of the search on the bed's faces whose best they are now (docs/trampoline.md)
+EDGES_BEST = {
+    "knee_land": 0.14445817435485553,
+    "lean": -0.0488264489650417,
+    "trunk": -0.03840802227306958,
+    "leg_omega": 12.8848547499585,
+    "ankle_share": 0.7741162175548496,
+    "thrust_delay": 0.16237907246390273,
+    "power": 0.5841121639613117,
+    "ankle_push": 0.35920869840470787,
+    "arm_swing": 3.1,
+    "arm_land": 0.003616482133918858,
+    "k_speed": 0.6,
+    "k_place": 0.46001672902920826,
+    "k_lead": 4.970550615473857,
+    "k_drift": 0.08162544824107555,
+    "k_spin": 0.0164970699297445,
+    "k_attitude": 0.04171894873496466,
+    "k_turn": 0.003324037518460548,
+    "k_hip_spin": -0.06,
+    "k_arms": 0.05108273094290473}
+
+
 def start_sets(values: dict = HAND_START) -> list[str]:
     """``--set`` items that put the search's start at ``values`` ({controller field: value})."""
     return [f"bounce.{k}={v!r}" for k, v in values.items()]

@@ -66,7 +66,8 @@ class TrampolineParams:
     bed: BedParams = BedParams()
     gymnast: GymnastParams = GymnastParams()
     bounce: BounceParams = BounceParams()
-    contact: PartContactParams = PartContactParams()
+    # the faces as well as the edges: a foot is narrower than the bed's facets
+    contact: PartContactParams = PartContactParams(faces=True)
     standin: BedSpringsParams = BedSpringsParams()
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
 
