@@ -116,12 +116,7 @@ def _on_one_facet(primitive, mass, tilt, faces, seconds=1.0):
     n = int(round(seconds / H))
     forces = []
     for _ in range(n):
-        body.clear_forces()
-        net.clear_forces()
-        res = contact.exchange(True, True)
-        net.advance(H, net.dt)
-        if res is None:
-            res = contact.complete(True)
+        res = contact_step(body, net, contact, H)
         body.advance(H)
         forces.append(res[0][2] if res[2] else 0.0)
     return body.x[2], float(np.mean(forces[n // 2:]))
@@ -244,12 +239,7 @@ def test_block_resting_on_the_bed_is_carried_with_its_weight():
     for k in range(n):
         if k == n - 2000:
             p0 = m * block.v[2]
-        block.clear_forces()
-        net.clear_forces()
-        res = contact.exchange(True, True)
-        net.advance(H, net.dt)
-        if res is None:
-            res = contact.complete(True)
+        res = contact_step(block, net, contact, H)
         block.advance(H)
         forces.append(res[0][2])
         depth.append(net.rest_height - net.x[:net.bed_points, 2].min())
