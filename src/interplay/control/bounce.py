@@ -69,30 +69,30 @@ class BounceParams:
     of the body's pitch spin the arms take in the air by circling (forward against a
     backward spin), so the trunk lands upright, a trampolinist's correction."""
     knee_land: float = param(
-        0.1, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
-    lean: float = param(0.013067336197741832, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
-    trunk: float = param(-0.029034583135383374, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
+        0.24248216393047864, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
+    lean: float = param(0.04123097909656632, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
+    trunk: float = param(-0.15749223801622314, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
     leg_omega: float = param(
-        13.599290972358455, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
+        12.039005719344434, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
     ankle_share: float = param(
-        0.6594812445410662, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
-    thrust_delay: float = param(0.15977712366621083, "s", ge=0.0, le=2.0, doc="after touchdown")
-    power: float = param(0.9211436989186281, "-", gt=0.0, le=5.0, doc="the extension's speed")
-    ankle_push: float = param(0.13960834318473667, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
+        0.4787877610561425, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
+    thrust_delay: float = param(0.10186381131316363, "s", ge=0.0, le=2.0, doc="after touchdown")
+    power: float = param(0.3282547105673322, "-", gt=0.0, le=5.0, doc="the extension's speed")
+    ankle_push: float = param(0.2937119821651646, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
     arm_swing: float = param(
-        3.031584092430814, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
+        2.992458576628844, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
     arm_land: float = param(
-        0.900846141901059, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
-    k_speed: float = param(0.4088016267910487, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+        0.9753128714654313, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
+    k_speed: float = param(0.4406028934995885, "s", ge=0.0, le=5.0, doc="foot placement on speed")
     k_place: float = param(
-        0.44660764515605406, "-", ge=0.0, le=5.0, doc="foot placement on offset")
-    k_lead: float = param(2.9457184109697683, "rad/m", ge=0.0, le=50.0)
-    k_drift: float = param(0.11856835722415564, "rad s/m", ge=0.0, le=20.0)
-    k_spin: float = param(0.025740446690318424, "rad s/(kg m^2)", ge=0.0, le=1.0)
-    k_attitude: float = param(0.057985445297466166, "-", ge=0.0, le=3.0)
-    k_turn: float = param(0.0017583143699759665, "m s/(kg m^2)", ge=-1.0, le=1.0)
-    k_hip_spin: float = param(-0.048651496501968365, "rad s/(kg m^2)", ge=-1.0, le=1.0)
-    k_arms: float = param(0.23585735263605434, "-", ge=0.0, le=5.0)
+        0.44176941099682676, "-", ge=0.0, le=5.0, doc="foot placement on offset")
+    k_lead: float = param(2.1706362907687864, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(0.018015126063999506, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.01601819208919427, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.14955399755798174, "-", ge=0.0, le=3.0)
+    k_turn: float = param(0.012788720878903427, "m s/(kg m^2)", ge=-1.0, le=1.0)
+    k_hip_spin: float = param(-0.052252244425987575, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    k_arms: float = param(0.3043088900154914, "-", ge=0.0, le=5.0)
 
     def validated(self) -> "BounceParams":
         for f in fields(self):

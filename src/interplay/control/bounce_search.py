@@ -175,8 +175,8 @@ HAND_START = {"knee_land": 0.2, "lean": 0.0, "trunk": 0.0, "leg_omega": 12.0,
               "k_hip_spin": -0.03, "k_arms": 0.0, "ankle_share": 1.0}
 
 
-#: the defaults of BounceParams until 2026-12-06: the second edges-only search's best, and the
-#: start of the search on the bed's faces whose best they are now (docs/trampoline.md)
+#: the second edges-only search's best (the defaults until 2026-12-06): the start of the first
+#: search on the bed's faces (docs/trampoline.md)
 EDGES_BEST = {
     "knee_land": 0.14445817435485553,
     "lean": -0.0488264489650417,
@@ -197,6 +197,30 @@ EDGES_BEST = {
     "k_turn": 0.003324037518460548,
     "k_hip_spin": -0.06,
     "k_arms": 0.05108273094290473}
+
+
+#: the first search on the bed's faces' best, with sharp feet: the start of the search with her
+#: feet rounded, whose best are the defaults now (docs/trampoline.md)
+FACES_BEST = {
+    "knee_land": 0.1,
+    "lean": 0.013067336197741832,
+    "trunk": -0.029034583135383374,
+    "leg_omega": 13.599290972358455,
+    "ankle_share": 0.6594812445410662,
+    "thrust_delay": 0.15977712366621083,
+    "power": 0.9211436989186281,
+    "ankle_push": 0.13960834318473667,
+    "arm_swing": 3.031584092430814,
+    "arm_land": 0.900846141901059,
+    "k_speed": 0.4088016267910487,
+    "k_place": 0.44660764515605406,
+    "k_lead": 2.9457184109697683,
+    "k_drift": 0.11856835722415564,
+    "k_spin": 0.025740446690318424,
+    "k_attitude": 0.057985445297466166,
+    "k_turn": 0.0017583143699759665,
+    "k_hip_spin": -0.048651496501968365,
+    "k_arms": 0.23585735263605434}
 
 
 def start_sets(values: dict = HAND_START) -> list[str]:
