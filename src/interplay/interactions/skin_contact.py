@@ -129,7 +129,13 @@ class _Projector:
             nrm = self.n[near]
             o = (np.einsum("ij,ij->i", nrm, v.x[near]) + self.p.thickness
                  - np.maximum(self.s[near], self.p.thickness))
+            before = v.v.copy()
             self.limiter.limit_strain(h, Planes(near, nrm, o))
+            # the limit's own velocity changes join the contact's in the reaction: its
+            # corrections along springs are equal and opposite pairs on one line (no net
+            # force or torque), so what remains is the skin's push through the planes and
+            # the pull of the waistband that rides it
+            self.dv += v.v - before
         c = np.zeros(3) if centre is None else np.asarray(centre, float)
         return reaction(v.x, v.masses, self.dv, h, c)
 
