@@ -243,6 +243,106 @@ def test_the_stretch_certificate_counts_the_overstretched_share(surface):
     assert net.certificates[0]["stretch"] == largest
 
 
+def strip_network(rows, cols=11, spacing=0.01, limit=0.05, pinned=None):
+    """A cotton jersey strip (cols x rows points, ``spacing`` m apart, in the x-z plane, top
+    row at z = 0) as a Garments network at 1/240 s, stretch limit ``limit``; pinned: the
+    points that ride (default the top row)."""
+    import dataclasses
+    X, Z = np.meshgrid(np.arange(cols) * spacing, -np.arange(rows) * spacing)
+    x = np.stack([X.ravel(), np.zeros(X.size), Z.ravel()], 1)
+    a = (np.arange(rows - 1)[:, None] * cols + np.arange(cols - 1)).ravel()
+    t = np.concatenate([np.stack([a, a + 1, a + cols], 1),
+                        np.stack([a + 1, a + cols + 1, a + cols], 1)])
+    fabric = dataclasses.replace(G.FABRICS["cotton_jersey"], stretch_limit=limit)
+    groups = {} if pinned is False else {
+        "pinned": np.arange(cols) if pinned is None else np.asarray(pinned)}
+    return G.network(G.Garment("strip", x, t, fabric, groups), dt=1.0 / 240.0)
+
+
+def structural_strain(net):
+    """The largest strain (l / l0 - 1) of the network's structural springs, bands (those
+    between two pinned points) apart."""
+    d = np.linalg.norm(net.x[net.si] - net.x[net.sj], axis=1) / net.l0 - 1.0
+    return float(d[(net.spring_kind == 0) & ~net.band].max())
+
+
+def test_a_loaded_strip_stretches_no_more_than_its_limit():
+    """A cotton jersey strip 0.1 m wide and 0.2 m long, pinned along its top, pulled down by
+    5 N on its bottom row (a 0.5 kg weight's pull) for 2 s. Its tension, 5 N / 0.1 m =
+    50 N/m, against the jersey's 400 N/m would strain it 12.5% at rest: without a limit the
+    strain passes 10%. With the 5% limit it never passes 5%: the passes end only when no
+    structural spring is over its cap (l0 x 1.05), so the bound is exact up to the
+    round-off of a length (1e-12), as long as no step ran out of passes (checked). The
+    weight's pull is a force on light points, not the weight's own mass: 1,000 times a
+    cloth point's mass at the corner makes the passes converge slowly (docs/clothing.md)."""
+    for limit in (np.inf, 0.05):
+        net = strip_network(21, limit=limit)
+        bottom = np.arange(len(net.x) - 11, len(net.x))
+        worst = 0.0
+        for _ in range(480):
+            net.clear_forces()
+            net.add_point_forces(bottom, np.tile([0.0, 0.0, -5.0 / 11], (11, 1)))
+            net.advance(1.0 / 240.0)
+            worst = max(worst, structural_strain(net))
+        if limit == np.inf:
+            assert worst > 0.10
+        else:
+            assert worst <= 0.05 + 1e-12
+            assert net.limit_stats[1] == 0  # no step left springs over their caps
+
+
+def test_the_strain_limit_keeps_momentum_and_pinned_points():
+    """A cotton strip stretched 20% with random jitter and random velocities: the limit
+    brings every structural spring to its cap or under, and each correction moves a
+    spring's two ends by opposite impulses (shares of 1/m), so the strip's linear momentum
+    is unchanged to round-off (1e-12 of sum m |v|) when no point is pinned. Pinned points
+    (the top row) do not move at all, and their velocities are not touched."""
+    rng = np.random.default_rng(3)
+    for pinned in (False, None):
+        net = strip_network(8, limit=0.05, pinned=pinned)
+        # stretched down from the top row (which stays where it is cut, so the pins leave
+        # room for the limit), with jitter on the free points
+        net.x[:, 2] *= 1.2
+        net.x[~net.fixed] += rng.normal(0.0, 0.001, (int((~net.fixed).sum()), 3))
+        net.v[:] = rng.normal(0.0, 0.5, net.v.shape)
+        p0, x0, v0 = net.momentum(), net.x.copy(), net.v.copy()
+        net.limit_strain(1.0 / 240.0)
+        assert structural_strain(net) <= 0.05 + 1e-12
+        pins = net.fixed
+        if pinned is False:
+            scale = float(np.sum(net.m[:, None] * np.abs(v0)))
+            assert np.abs(net.momentum() - p0).max() <= 1e-12 * scale
+        else:
+            assert pins.sum() == 11
+            assert np.array_equal(net.x[pins], x0[pins])
+            assert np.array_equal(net.v[pins], v0[pins])
+        moved = ~pins
+        # the velocity changes by the move over the step: x - x_n = h v still holds
+        assert np.allclose((net.v - v0)[moved] / 240.0, (net.x - x0)[moved], atol=1e-15)
+
+
+def test_the_strain_limit_leaves_a_contact_plane_on_its_outer_side():
+    """A strip (in the x-z plane) pinned along both side edges, stretched 20% between them,
+    its middle column pushed 2 cm out of the plane by a post: the half-space y >= 0.02 m.
+    Shortening its springs pulls the middle back towards the pins' plane (y = 0: without
+    the post it ends below 0.02 m); the post's projection follows every pass, so the middle
+    stays on it (to round-off)."""
+    from interplay.kernels.strain_limit import Planes
+    for post in (False, True):
+        net = strip_network(11, cols=11, limit=0.05, pinned=np.r_[0:121:11, 10:121:11])
+        net.x[:, 0] *= 1.2
+        mid = np.flatnonzero(np.isclose(net.x[:, 0], 0.06))
+        net.x[mid, 1] = 0.02
+        planes = Planes(mid, np.tile([0.0, 1.0, 0.0], (len(mid), 1)), np.full(len(mid), 0.02))
+        before = structural_strain(net)
+        net.limit_strain(1.0 / 240.0, planes if post else None)
+        assert structural_strain(net) < before
+        if post:
+            assert net.x[mid, 1].min() >= 0.02 - 1e-12
+        else:
+            assert net.x[mid, 1].min() < 0.02 - 1e-3
+
+
 def test_bad_garment_meshes_are_refused_naming_the_element(surface, tmp_path):
     x = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0, -1, 0]], float) * 0.01
     t = np.array([[0, 1, 2], [0, 1, 3], [0, 1, 4]])

@@ -71,8 +71,20 @@ def mocap():
     return MocapFigure("runner", path)
 
 
+def garments():
+    """A jersey strip pinned along its top as a Garments network (its stretch limit's
+    counters are part of its memory)."""
+    from interplay.geometry import garment as G
+    x, t = shapes.grid(0.1, 0.2, 6, 11, origin=(0, 0, 1.0))
+    net = G.network(G.Garment("strip", x, t, G.FABRICS["cotton_jersey"],
+                              {"pinned": np.arange(6)}), dt=1 / 240)
+    net.x[6:, 1] *= 1.5  # stretched 50% away from the pins: the limit acts at once
+    return net
+
+
 SYSTEMS = {
     "sphere": (sphere, 1e-3),
+    "garments": (garments, 1 / 240),
     "cloth-explicit": (lambda: cloth("explicit", dt=2e-4), 1 / 240),
     "cloth-implicit": (lambda: cloth("implicit"), 1 / 240),
     "cloth-bdf2": (lambda: cloth("implicit", scheme="bdf2"), 1 / 240),

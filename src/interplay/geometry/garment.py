@@ -46,7 +46,8 @@ from .mesh import edges as mesh_edges
 class Fabric:
     """A textile: areal density (kg/m^2), tensile stiffness per unit width at small strain
     (N/m: force per width per unit strain), shear and bending (N m: bending rigidity per
-    width), friction against skin (-), thickness (m)."""
+    width), friction against skin (-), thickness (m), stretch limit (-): the largest strain
+    its structural springs may take (systems/garments.Garments.limit_strain; inf: none)."""
     name: str
     density: float
     tensile: float
@@ -54,16 +55,20 @@ class Fabric:
     bending: float
     friction: float
     thickness: float
+    stretch_limit: float = float("inf")
 
 
-#: measured fabrics (docs/clothing.md gives the sources and how the values were taken)
+#: measured fabrics (docs/clothing.md gives the sources and how the values were taken; the
+#: stretch limits are chosen there: 5%, the cotton tee's bar of issue 16, for all three)
 FABRICS = {
     "cotton_jersey": Fabric("cotton jersey", density=0.16, tensile=400.0, shear=60.0,
-                            bending=2.0e-6, friction=0.5, thickness=0.0006),
+                            bending=2.0e-6, friction=0.5, thickness=0.0006,
+                            stretch_limit=0.05),
     "fleece": Fabric("polyester fleece", density=0.28, tensile=250.0, shear=40.0,
-                     bending=8.0e-6, friction=0.6, thickness=0.002),
+                     bending=8.0e-6, friction=0.6, thickness=0.002, stretch_limit=0.05),
     "cotton_twill": Fabric("cotton twill", density=0.22, tensile=2000.0, shear=150.0,
-                           bending=1.5e-5, friction=0.5, thickness=0.0007),
+                           bending=1.5e-5, friction=0.5, thickness=0.0007,
+                           stretch_limit=0.05),
 }
 
 

@@ -35,6 +35,7 @@ from ..errors import ParameterError, require_nonnegative, require_positive
 from ..geometry.aabb_tree import AABBTree
 from ..kernels.skin_contact import (Law, Nearest, Skin, edge_neighbours, project, reaction,
                                     signed_distance, vertex_normals)
+from ..kernels.strain_limit import Planes
 from ..params import param
 from .base import Interaction
 
@@ -94,6 +95,11 @@ class _Projector:
         self.dv, self.s, self.n = np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3))
         self.vn = np.zeros((len(X0), 3))
         self.x0 = self.view.x.copy()  # the points at the step's start
+        # a garment's stretch limit runs after the projection, held off the skin by its
+        # planes (systems/garments.Garments.limit_strain): the two then agree
+        self.limiter = cloth if hasattr(cloth, "limit_strain") else None
+        if self.limiter is not None:
+            cloth.limit_by_contact = True
         self.approach = 0.0  # m: the deepest a point was found inside the skin
         self.count = 0
 
@@ -115,6 +121,21 @@ class _Projector:
         self.count = int(project(v.points, self.x0, Skin(X, V, self.tris),
                                  Nearest(tri, bary, self.s, self.n),
                                  Law(self.p.thickness, self.p.friction, h), self.dv))
+        if self.limiter is not None:
+            # each point found near the skin keeps the thickness off its nearest point's
+            # tangent plane: n . x >= n . x_now + thickness - max(s, thickness) (a point
+            # just pushed out stays where it is along n)
+            near = np.flatnonzero(tri >= 0)
+            nrm = self.n[near]
+            o = (np.einsum("ij,ij->i", nrm, v.x[near]) + self.p.thickness
+                 - np.maximum(self.s[near], self.p.thickness))
+            before = v.v.copy()
+            self.limiter.limit_strain(h, Planes(near, nrm, o))
+            # the limit's own velocity changes join the contact's in the reaction: its
+            # corrections along springs are equal and opposite pairs on one line (no net
+            # force or torque), so what remains is the skin's push through the planes and
+            # the pull of the waistband that rides it
+            self.dv += v.v - before
         c = np.zeros(3) if centre is None else np.asarray(centre, float)
         return reaction(v.x, v.masses, self.dv, h, c)
 

@@ -17,6 +17,10 @@ worn on (``watch``), at every output frame it measures, exactly:
   than ``OVERSTRETCH`` (5%, a cotton tee's limit in issue 16): the largest strain is one
   spring's, this says whether it is a pinch or the garment.
 
+Each step ends with the fabric's stretch limit (``limit_strain``, kernels/strain_limit.py):
+structural springs past their fabric's limit are shortened back, after the skin contact's
+projection and held off the skin by its planes when one acts (interactions/skin_contact).
+
 ``dress`` pulls a garment onto a body before t = 0: the skin moves from the A-pose the garment
 was cut in to the pose of the first frame while the cloth follows under its springs, gravity,
 the skin contact and its self-contacts, then settles; at the end each point takes the skin's
@@ -28,10 +32,15 @@ import numpy as np
 
 from ..errors import SceneError
 from ..geometry.aabb_tree import AABBTree
+from ..kernels import strain_limit as SL
 from ..kernels.skin_contact import signed_distance, vertex_normals
+from .base import substeps
 from .springmass import SpringNetwork, Springs
 
 OVERSTRETCH = 0.05  # strain past which a cotton knit is visibly overstretched (issue 16)
+#: most Gauss-Seidel passes of the strain limit a step (kernels/strain_limit.py): 60 keep the
+#: runner's garments' pass within 1.3x of its time without the limit (docs/clothing.md)
+LIMIT_SWEEPS = 60
 
 
 class Garments(SpringNetwork):
@@ -44,24 +53,78 @@ class Garments(SpringNetwork):
         self.spring_kind = kind
         self.parts = ({p.name: garment.groups[p.name] for p in garment.parts}
                       if garment.parts else {garment.name: np.arange(len(self.x))})
-        band = np.zeros(len(self.l0), bool)
-        if len(garment.ring_edges):
-            key = lambda p: p.min(axis=1) * len(self.x) + p.max(axis=1)  # noqa: E731
-            rings = set(key(np.asarray(garment.ring_edges)).tolist())
-            mine = key(np.stack([self.si, self.sj], 1))
-            band = np.array([k in rings for k in mine.tolist()]) & (kind == 0)
-        self.band = band
         # the points that ride the skin (a gripping waistband): fixed in the solve, moved
         # with the skin point they were cut on by the skin's own weights
         pins = [v for k, v in garment.groups.items() if k == "pinned" or k.endswith(".pinned")]
         self.pinned = np.unique(np.concatenate(pins)) if pins else np.zeros(0, np.int64)
         self.fixed[:] = False
         self.fixed[self.pinned] = True
+        # the elastic bands: the rings cut short to grip, and every spring within the
+        # waistband that rides the skin (both ends pinned: the skin stretches it, no cloth
+        # force can); they stretch by design, apart in the certificates and not limited
+        band = self.fixed[self.si] & self.fixed[self.sj]
+        if len(garment.ring_edges):
+            key = lambda p: p.min(axis=1) * len(self.x) + p.max(axis=1)  # noqa: E731
+            rings = set(key(np.asarray(garment.ring_edges)).tolist())
+            mine = key(np.stack([self.si, self.sj], 1))
+            band |= np.array([k in rings for k in mine.tolist()])
+        self.band = band & (kind == 0)
+        # each structural spring's cap from its garment's fabric
+        limit = np.full(len(self.x), np.inf)
+        for p in (garment.parts or (garment,)):
+            limit[self.parts[p.name]] = p.fabric.stretch_limit
+        on = (kind == 0) & ~self.band & np.isfinite(limit[self.si])
+        self.limits = SL.Limits(self.si[on], self.sj[on], self.l0[on] * (1.0 + limit[self.si[on]]))
+        self.reach = self._reach(limit)
+        # a skin contact runs the limit itself, after its projection (interactions/
+        # skin_contact._Projector), so the two agree; otherwise the advance ends with it
+        self.limit_by_contact = False
+        self.limit_stats = np.zeros(3)  # passes at most, steps left over, excess left
         self._pin_skin = None  # geometry.skinning.Skinning of the pinned points, cut
         self._cut_skin = None  # and of all points (made on first use)
         self._skin = None
         self.certificates: list = []
         self._own = None
+
+    def advance(self, h, dt=None):
+        super().advance(h, dt)
+        if not self.limit_by_contact:
+            # the velocity is the last substep's: x - x_n = (h / n) v
+            self.limit_strain(h / substeps(h, self.dt if dt is None else dt))
+
+    def limit_strain(self, h: float, planes=None) -> None:
+        """Shorten the structural springs stretched past their fabric's limit back to it
+        (kernels/strain_limit.py: Provot's correction, shared by inverse mass, so the points'
+        linear momentum is kept; pinned points stay), keeping the points of ``planes`` (a
+        strain_limit.Planes: a contact's half-spaces) on their outer sides; the velocities
+        change by the move over the step h (s)."""
+        if not len(self.limits.i):
+            return
+        w = np.where(self.fixed, 0.0, 1.0 / self.m)
+        passes, left = SL.limit_strain(self.x, self.v, w, self.limits, self.reach,
+                                       SL.no_planes() if planes is None else planes, h,
+                                       LIMIT_SWEEPS)
+        st = self.limit_stats
+        st[0] = max(st[0], passes)
+        st[1] += left > 0.0
+        st[2] = max(st[2], left)
+
+    def _reach(self, limit) -> SL.Reach:
+        """Each free point's reach from its nearest pinned point (kernels/strain_limit.Reach):
+        the shortest rest path to a pin along the structural springs, bands apart (never shorter
+        than the cloth's own geodesic) times 1 + its limit (limit (n,) per point)."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+        free = np.flatnonzero(~self.fixed & np.isfinite(limit))
+        if not len(self.pinned) or not len(free):
+            return SL.Reach(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+        on = (self.spring_kind == 0) & ~self.band  # a band's rest length is cut short
+        n = len(self.x)
+        graph = coo_matrix((self.l0[on], (self.si[on], self.sj[on])), shape=(n, n)).tocsr()
+        dist, _, source = dijkstra(graph, directed=False, indices=self.pinned,
+                                   return_predecessors=True, min_only=True)
+        free = free[np.isfinite(dist[free])]
+        return SL.Reach(free, source[free].astype(np.int64), dist[free] * (1.0 + limit[free]))
 
     def ride(self, surface, seg_pos, seg_rot, h: float) -> None:
         """Move the pinned points to where the skin carries them at the segment poses
@@ -157,6 +220,9 @@ class Garments(SpringNetwork):
 
     def extra_diagnostics(self) -> dict:
         out = dict(super().extra_diagnostics())
+        st = self.limit_stats
+        out["strain_limit"] = {"passes_max": int(st[0]), "steps_left_over": int(st[1]),
+                               "excess_left_max": float(st[2])}
         if self.certificates:
             c = self.certificates
             out["certificates"] = {
@@ -175,6 +241,7 @@ class Garments(SpringNetwork):
         crossings, penetration, self-crossings, then each stretch key's value, then each
         overstretched key's)."""
         snap = super().capture()
+        snap["limit_stats"] = self.limit_stats.copy()
         c0 = self.certificates[0] if self.certificates else {"stretch": {}, "overstretched": {}}
         keys, share = sorted(c0["stretch"]), sorted(c0["overstretched"])
         rows = [[c["t"], c["cloth_body_intersections"], c["penetration_m"],
@@ -190,6 +257,7 @@ class Garments(SpringNetwork):
         snap = dict(snap)
         rows, keys = snap.pop("cert", None), snap.pop("cert_keys", None)
         share = snap.pop("cert_share_keys", None)
+        self.limit_stats[:] = snap.pop("limit_stats", np.zeros(3))
         super().restore(snap)
         if rows is not None:
             keys = [str(k) for k in np.asarray(keys).ravel()]
