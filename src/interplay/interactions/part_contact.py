@@ -51,7 +51,11 @@ class PartContactParams:
     parts' features (a box's corners, a capsule's ends, a sphere's centre) collide with the
     network's triangles' faces as well as their edges, so a part narrower than a facet rests
     on it instead of wedging between its edges (a foot on a trampoline's bed: without it the
-    bed's 0.12 m facets let a 1500 N foot through, docs/trampoline.md)."""
+    bed's 0.12 m facets let a 1500 N foot through, docs/trampoline.md); golden_steps: the
+    golden-section steps of a box's deepest point along a segment, its bracket 0.618^steps of
+    the segment (14: 1e-3, whose tenth-of-a-millimetre steps made a box on the trampoline's
+    bed chaotic; 40: 4e-9, at no measurable cost; the swing's dressing, sensitive to a hair,
+    was made at 14)."""
     thickness: float = param(0.004, "m", ge=0.0, le=0.2)
     friction: float = param(0.8, "-", ge=0.0, le=10.0)
     eps: float = param(0.01, "m/s", gt=0.0, le=10.0)
@@ -63,6 +67,7 @@ class PartContactParams:
     rounding: float = param(0.0, "m", ge=0.0, le=0.2, doc="boxes' edges rounded by this radius")
     stick: bool = param(False, doc="friction sticks (a spring per touched point), no creep")
     faces: bool = param(False, doc="the parts' corners and ends against the triangles' faces")
+    golden_steps: int = param(14, "steps", ge=1, le=60, doc="a box's deepest-point search")
 
     def validated(self, owner: str) -> "PartContactParams":
         require_nonnegative(owner, "contact thickness", self.thickness, "m")
@@ -181,7 +186,7 @@ class PartContact(Interaction):
         return PC.Parts(kind, p, q, size, reach, np.zeros((k, 3)), np.zeros((k, 3, 3)),
                         np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
                         np.asarray(v.masses, float)[own].copy(), law,
-                        float(self.p.contact_steps),
+                        float(self.p.contact_steps), int(self.p.golden_steps),
                         elems, np.zeros(k + 1, np.int64), np.zeros(k * len(elems), np.int64),
                         np.zeros((k, 7)), np.zeros(1), np.zeros(3),
                         np.zeros((k, n, 3)), np.full((k, n), -2, np.int64),

@@ -39,7 +39,8 @@ class Parts(NamedTuple):
     Motion at the step's start: centres (k,3) m, rotations (k,3,3) part to world, velocities
     (k,3) m/s, spins (k,3) rad/s, accels (k,3) m/s^2; masses (k,) kg; law (k,6) each part's
     contact law (kernels/contact.py; STIFFNESS, DAMPING < 0: from the pair's mass, resolving
-    a penetration over ``steps`` substeps, critically damped). elems (s,3) the network's
+    a penetration over ``steps`` substeps, critically damped); golden: a box's golden-section
+    steps along a segment (primitive_distance.closest). elems (s,3) the network's
     elements (module docstring); start (k+1,), cand (c,) candidate elements of each part (``candidates``).
     Out: impulses (k,7) impulse (N s), angular impulse about the centre of mass (N m s) and
     peak force (N) per part over the step; peak (1,) the largest total force (N) of any
@@ -63,6 +64,7 @@ class Parts(NamedTuple):
     masses: np.ndarray
     law: np.ndarray
     steps: float
+    golden: int
     elems: np.ndarray
     start: np.ndarray
     cand: np.ndarray
@@ -271,7 +273,8 @@ def find_touches(parts, tau, x, tc):
                 continue  # the element's box misses the primitive's: no contact this substep
             ia, ib, ic = el[0], el[1], el[2]
             if ic < 0:  # a segment, or a point (ia == ib)
-                t, gap = closest(kind, pj, qj, size, c, R, x, ia, ib, A, B, X, P, n)
+                t, gap = closest(kind, pj, qj, size, c, R, x, ia, ib, A, B, X, P, n,
+                                 parts.golden)
                 pen = thickness - gap
                 if pen <= 0.0:
                     continue

@@ -19,10 +19,6 @@ import numpy as np
 from numba import njit
 
 SPHERE, CAPSULE, BOX = 0, 1, 2
-# shrinks the bracket to 0.618^40 ~ 4e-9 of the segment's length: at 14 (1e-3) the deepest
-# point moved in steps of a tenth of a millimetre as the segment moved smoothly, and a box on
-# the trampoline's bed turned a nanometre of its drop into 0.04 rad/s of spin within 0.4 s
-GOLDEN_ITERATIONS = 40
 
 
 @njit(cache=True, inline="always")
@@ -62,12 +58,13 @@ def _box_sd(C, R, h0, h1, h2, px, py, pz, g):
 
 
 @njit(cache=True, inline="always")
-def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
+def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n, golden):
     """Deepest approach of a part's primitive (kind, p, q, size as in Parts; the part at
     centre c, rotation R) to element ia-ib: returns (the element's parameter t in [0,1],
     signed gap s: distance from the part's surface, negative inside); writes the element's
     contact point X, the part's surface point P and the unit normal n (element towards
-    part). A, B are scratch (3,)."""
+    part). A, B are scratch (3,). golden: a box's golden-section steps along the segment (its
+    bracket shrinks to 0.618^golden of the segment: 14 ~ 1e-3, 40 ~ 4e-9)."""
     for r in range(3):
         A[r] = c[r] + R[r, 0] * p[0] + R[r, 1] * p[1] + R[r, 2] * p[2]
     xa, xb = x[ia], x[ib]
@@ -93,7 +90,7 @@ def closest(kind, p, q, size, c, R, x, ia, ib, A, B, X, P, n):
             t1, t2 = 1.0 - gr, gr
             f1 = _local_sd(a0 + t1 * e0, a1 + t1 * e1, a2 + t1 * e2, h0, h1, h2)
             f2 = _local_sd(a0 + t2 * e0, a1 + t2 * e1, a2 + t2 * e2, h0, h1, h2)
-            for _ in range(GOLDEN_ITERATIONS):
+            for _ in range(golden):
                 if f1 <= f2:
                     hi, t2, f2 = t2, t1, f1
                     t1 = hi - gr * (hi - lo)

@@ -68,8 +68,9 @@ class TrampolineParams:
     bounce: BounceParams = BounceParams()
     # the faces as well as the edges: a foot is narrower than the bed's facets; her feet's
     # edges rounded by 2 cm (soft tissue): a sharp box's normal flips at its edges, and a
-    # sharp foot on the bed turned a nanometre of the drop into 0.02 kg m^2/s at takeoff
-    contact: PartContactParams = PartContactParams(faces=True, rounding=0.02)
+    # sharp foot on the bed turned a nanometre of the drop into 0.02 kg m^2/s at takeoff; the
+    # deepest point along a bed edge to 4e-9 of it (at 1e-3 its steps did the same)
+    contact: PartContactParams = PartContactParams(faces=True, rounding=0.02, golden_steps=40)
     standin: BedSpringsParams = BedSpringsParams()
     coupling_dt: float = param(1e-3, "s", gt=0.0, le=0.01)
 
