@@ -100,7 +100,11 @@ def candidates(parts, x, v, h, margin):
     box its primitive sweeps over h (s): its boxes at the step's start and end (the spin's
     turn bounded by |w| h reach), grown by the contact skin, by how far the network's points
     move in h at their fastest and by ``margin`` (m). Returns the total count; parts away from
-    the network's box are skipped whole, so flight costs a box test per part."""
+    the network's box are skipped whole, so flight costs a box test per part. The elements'
+    boxes are computed once and sorted along x, so a part tests only those in its x slab (a
+    body lying on a bed tested all 1,650 of the bed's edges and faces per part, 37% of the
+    trampoline's run); each part's candidates are kept in element order, as a full scan
+    gives them (the same sums, to the bit)."""
     elems, start, cand = parts.elems, parts.start, parts.cand
     n = x.shape[0]
     nlo = np.empty(3)
@@ -120,6 +124,12 @@ def candidates(parts, x, v, h, margin):
     lo, hi, lo1, hi1 = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     c1 = np.empty(3)
     k = 0
+    boxes = False  # the elements' boxes, computed when a part first comes near the network
+    ne = elems.shape[0]
+    elo, ehi = np.empty((ne, 3)), np.empty((ne, 3))
+    order = np.empty(ne, np.int64)
+    xlo = np.empty(ne)
+    wide = 0.0  # the widest element along x
     for j in range(parts.kind.shape[0]):
         start[j] = k
         R = parts.rotations[j]
@@ -139,12 +149,37 @@ def candidates(parts, x, v, h, margin):
                 far = True
         if far:
             continue
-        for e in range(elems.shape[0]):
-            if _meets(x, elems[e], lo, hi, 0.0):
+        if not boxes:
+            _element_boxes(x, elems, elo, ehi)
+            order[:] = np.argsort(elo[:, 0])
+            xlo[:] = elo[order, 0]
+            wide = (ehi[:, 0] - elo[:, 0]).max() if ne else 0.0
+            boxes = True
+        first = k
+        for q in range(np.searchsorted(xlo, lo[0] - wide), np.searchsorted(xlo, hi[0], "right")):
+            e = order[q]
+            if (ehi[e, 0] >= lo[0] and ehi[e, 1] >= lo[1] and elo[e, 1] <= hi[1]
+                    and ehi[e, 2] >= lo[2] and elo[e, 2] <= hi[2]):
                 cand[k] = e
                 k += 1
+        cand[first:k].sort()
     start[parts.kind.shape[0]] = k
     return k
+
+
+@njit(cache=True)
+def _element_boxes(x, elems, elo, ehi):
+    """Each element's bounding box (lo, hi) over its points (-1: none) into elo, ehi (s,3)."""
+    for e in range(elems.shape[0]):
+        for r in range(3):
+            elo[e, r] = x[elems[e, 0], r]
+            ehi[e, r] = x[elems[e, 0], r]
+        for s_ in range(1, 3):
+            p = elems[e, s_]
+            if p >= 0:
+                for r in range(3):
+                    elo[e, r] = min(elo[e, r], x[p, r])
+                    ehi[e, r] = max(ehi[e, r], x[p, r])
 
 
 @njit(cache=True)
