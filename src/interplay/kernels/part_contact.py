@@ -41,7 +41,8 @@ class Parts(NamedTuple):
     contact law (kernels/contact.py; STIFFNESS, DAMPING < 0: from the pair's mass, resolving
     a penetration over ``steps`` substeps, critically damped); golden: a box's golden-section
     steps along a segment (primitive_distance.closest). elems (s,3) the network's
-    elements (module docstring); start (k+1,), cand (c,) candidate elements of each part (``candidates``).
+    elements (module docstring); start (k+1,), cand (c,) candidate elements of each part
+    (``candidates``).
     Out: impulses (k,7) impulse (N s), angular impulse about the centre of mass (N m s) and
     peak force (N) per part over the step; peak (1,) the largest total force (N) of any
     substep; received (3,) the impulse (N s) the network's points received (minus the parts'

@@ -188,9 +188,10 @@ def face_feature(kind, p, q, size, c, R, f, x, ia, ib, ic, X, P, n, w):
     can reach through it (a box's corner: the inner box's thickness, its smallest extent; an
     end's or a sphere's centre: none), which is a part that has passed the face, or a face
     turned away from it. (Half the thickness let a foot box through the bed under 2000 N:
-    under a bed point pressed by ~1000 N a corner sinks 3 cm into the contact's skin.) Writes the face point X (the feature's foot), the part's surface point P, the
-    normal n (the face's, turned towards the part's centre c) and X's barycentric weights w
-    (3,) on ia, ib, ic."""
+    under a bed point pressed by ~1000 N a corner sinks 3 cm into the contact's skin.)
+    Writes the face point X (the feature's foot), the part's surface point P, the normal n
+    (the face's, turned towards the part's centre c) and X's barycentric weights w (3,) on
+    ia, ib, ic."""
     xa, xb, xc = x[ia], x[ib], x[ic]
     if kind == BOX:
         rnd = q[0]

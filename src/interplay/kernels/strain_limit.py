@@ -137,8 +137,9 @@ def _keep_out(x, w, planes):
 def limit_strain(x, v, w, lim, reach, planes, h, sweeps):
     """Shorten every spring of ``lim`` longer than its cap, in up to ``sweeps`` Gauss-Seidel
     passes alternating forward and backward, each after the Reach and followed by the
-    planes, until a full pass finds no spring over its cap and the planes move nothing. Between full passes only the
-    springs within NEAR of their caps at the last full one are visited. The velocities v
+    planes, until a full pass finds no spring over its cap and the planes move nothing.
+    Between full passes only the springs within NEAR of their caps at the last full one are
+    visited. The velocities v
     change by each point's move over the step h (s), as Provot's do, so that x - x_n = h v
     still holds for the step that ends here. Returns (passes taken, the largest excess over
     a cap the last pass found: 0 if none)."""
