@@ -18,7 +18,8 @@ Balance (``BounceBalance``, the figure's feedback at every control tick), after 
 hopping machines: in the air the legs are placed for the landing, hip flexion (forward-back)
 and abduction (sideways) turned so the feet land ahead of the centre of mass by
 ``k_speed`` v + ``k_place`` (c - c0) along each axis (v the centre of mass's horizontal
-velocity, c - c0 its offset from the bed's centre), which brakes a drift and steers her back;
+velocity, c - c0 its offset from the bed's centre), which brakes a drift and steers her back,
+and with ``aim`` the hips are servoed in the descent on the feet's measured miss from there;
 on the bed the hips servo the pelvis upright against the planted legs (``k_attitude`` of the
 legs' lean), which stops the body rotating. Offsets slew at most SLEW so a new phase does not
 kick the servos.
@@ -67,7 +68,11 @@ class BounceParams:
     a forward one), which turns the legs' push on the bed, and with it the bed's friction
     under the feet a metre below the centre of mass, against the spin; k_arms (-): the share
     of the body's pitch spin the arms take in the air by circling (forward against a
-    backward spin), so the trunk lands upright, a trampolinist's correction."""
+    backward spin), so the trunk lands upright, a trampolinist's correction; aim (-): in the
+    descent the hips are servoed on where the feet are, each tick's hip target the present
+    angle turned by aim times the feet's miss over the leg's length (0: the placement is the
+    open-loop leg angle above, blind to where the hips' servos leave the feet and to the
+    trunk's tilt carrying the centre of mass off the hips)."""
     knee_land: float = param(
         0.24248216393047864, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
     lean: float = param(0.04123097909656632, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
@@ -93,6 +98,7 @@ class BounceParams:
     k_turn: float = param(0.012788720878903427, "m s/(kg m^2)", ge=-1.0, le=1.0)
     k_hip_spin: float = param(-0.052252244425987575, "rad s/(kg m^2)", ge=-1.0, le=1.0)
     k_arms: float = param(0.3043088900154914, "-", ge=0.0, le=5.0)
+    aim: float = param(0.0, "-", ge=0.0, le=10.0, doc="the hips servoed on the feet's miss")
 
     def validated(self) -> "BounceParams":
         for f in fields(self):
@@ -114,7 +120,7 @@ BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4),
           "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6), "k_place": (0.0, 1.0),
           "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5), "k_spin": (0.0, 0.05),
           "k_attitude": (0.0, 1.2), "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
-          "k_arms": (0.0, 1.5)}
+          "k_arms": (0.0, 1.5), "aim": (0.0, 4.0)}
 
 
 def controller(p: BounceParams) -> Controller:
@@ -219,13 +225,21 @@ class BounceBalance:
                 return float(np.clip(math.asin(np.clip(a / LEG_LENGTH, -1.0, 1.0)),
                                      -PLACE_MAX, PLACE_MAX))
             tilt = PLACE_MAX
-            along = angle(p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2])
-                          + turn_fwd)
-            side = angle(p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2])
-                         + turn_side)
-            want[self.flex] = along + float(np.clip(pitch, -tilt, tilt))
-            want[self.abd_l] = side - float(np.clip(roll, -tilt, tilt))
+            # m: where the feet should land, ahead of and left of the centre of mass
+            fore = p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2]) + turn_fwd
+            aside = p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2]) + turn_side
+            want[self.flex] = angle(fore) + float(np.clip(pitch, -tilt, tilt))
+            want[self.abd_l] = angle(aside) - float(np.clip(roll, -tilt, tilt))
             want[self.abd_r] = -want[self.abd_l]
+            if p.aim > 0.0 and fig.fsm.state.name == "descend":
+                # the feet's miss (m) from there: each tick the hips aim from where they are,
+                # so the servos' lag and the trunk's tilt are seen
+                ahead = d.geom_xpos[fig.sole_geoms].mean(axis=0) - com
+                miss = np.array([fore - ahead @ fwd, aside - ahead @ left]) * (p.aim / LEG_LENGTH)
+                now = fig.angles() - fig.reference()
+                want[self.flex] = now[self.flex] + miss[0]
+                want[self.abd_l] = now[self.abd_l] + miss[1]
+                want[self.abd_r] = now[self.abd_r] - miss[1]
         step = SLEW * fig.control_dt
         self.out[:] = np.clip(want, self.out - step, self.out + step)
         # the arms circle in the air against the body's pitch spin (the offset integrates the

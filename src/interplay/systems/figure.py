@@ -215,6 +215,11 @@ class Figure(System, RigidParts):
             target += self.offsets
         return target, vtarget
 
+    def reference(self) -> np.ndarray:
+        """The state's desired joint angles (rad) now, before the balance and the feedback's
+        offsets: what an offset is added to."""
+        return self._reference(self.time, balance=False)[0]
+
     def _feedforward(self, target) -> np.ndarray:
         """Gravity compensation (N m) for the desired angles (control/gravity.py): the weight
         on the feet while the state says they carry the body and one touches the ground."""
