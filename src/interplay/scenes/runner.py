@@ -19,7 +19,7 @@ import numpy as np
 
 from ..geometry.body_surface import SurfaceParams, figure_surface
 from ..geometry.clearance import ClearanceParams
-from ..geometry.garment import Fit, join, network, sweatpants, tee
+from ..geometry.garment import PANTS_FIT, Fit, join, network, sweatpants, tee
 from ..interactions.mesh_contact import MeshContactParams, SelfContact
 from ..interactions.skin_contact import PosedSkin, SkinContact, SkinContactParams
 from ..outputs.render.camera import TrackingCamera
@@ -53,7 +53,7 @@ class RunnerParams:
     clearance: ClearanceParams = ClearanceParams(arms=ARM_ROOM)
     skin: SurfaceParams = SurfaceParams()
     tee: Fit = Fit(spacing=0.016)
-    pants: Fit = Fit(spacing=0.016, ease=0.025)
+    pants: Fit = replace(PANTS_FIT, spacing=0.016)
     contact: SkinContactParams = SkinContactParams()
     self_thickness: float = param(0.0, "m", ge=0.0, le=0.05)
     cloth_dt: float = param(1.0 / 240.0, "s", ge=1e-5, le=0.02)
