@@ -119,8 +119,13 @@ class _Projector:
     def resolve(self, X, V, h, centre=None):
         """Project the cloth against the skin (X, V) over a step h; (force, torque about
         centre) on the skin."""
-        self.tree.refit(X)
         v = self.view
+        if self.layers is not None:
+            # the layers first, so that the skin contact has the last word: where the body
+            # leaves no room for two layers (between the thighs) they touch rather than one
+            # being pushed into the skin (systems/garment_layers.py)
+            self.layers.project(h)
+        self.tree.refit(X)
         tri, d, bary = self.tree.nearest(v.x, self.p.thickness + self.p.reach)
         vertex_normals(X, self.tris, self.vn)
         signed_distance(v.x, tri, bary, d, X, self.tris, self.across, self.vn, self.s, self.n)
@@ -131,7 +136,7 @@ class _Projector:
                                  Nearest(tri, bary, self.s, self.n),
                                  Law(self.p.thickness, self.p.friction, h), self.dv))
         self.limb[:] = np.where(tri >= 0, self.limbs[self.tris[tri, 0]], -1)
-        if self.limiter is not None or self.layers is not None:
+        if self.limiter is not None:
             # each point found near the skin keeps the thickness off its nearest point's
             # tangent plane: n . x >= n . x_now + thickness - max(s, thickness) (a point
             # just pushed out stays where it is along n)
@@ -139,12 +144,8 @@ class _Projector:
             nrm = self.n[near]
             o = (np.einsum("ij,ij->i", nrm, v.x[near]) + self.p.thickness
                  - np.maximum(self.s[near], self.p.thickness))
-            planes = Planes(near, nrm, o)
             before = v.v.copy()
-            if self.layers is not None:
-                self.layers.project(h, planes)
-            if self.limiter is not None:
-                self.limiter.limit_strain(h, planes)
+            self.limiter.limit_strain(h, Planes(near, nrm, o))
             # the limit's own velocity changes join the contact's in the reaction: its
             # corrections along springs are equal and opposite pairs on one line (no net
             # force or torque), so what remains is the skin's push through the planes and

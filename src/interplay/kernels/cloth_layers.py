@@ -26,7 +26,6 @@ import numpy as np
 from numba import njit, prange
 
 from .aabb_tree import STACK, _box_dist2
-from .strain_limit import _keep_out
 from .trimesh_contact import closest_on_triangle
 
 
@@ -151,15 +150,13 @@ def sides(x, mesh, body, tri, out_side):
 
 
 @njit(cache=True)
-def project(x, v, w, mesh, tri, side, thickness, step, planes, passes, h):
+def project(x, v, w, mesh, tri, side, thickness, step, passes, h):
     """Hold every point on its side of its candidate triangles, ``thickness`` (m) off their
-    planes, in up to ``passes`` Gauss-Seidel passes, each followed by the ``planes`` (a
-    strain_limit.Planes: the skin contact's half-spaces, so the layers are pushed apart
-    without pushing one into the body). A pair acts while the point lies over its triangle
-    (its closest point's offset within the triangle's plane is under ``thickness``); each
-    correction is split over the point and the triangle's corners by inverse mass and
-    barycentric weight (momentum kept) and capped at ``step`` (m). The velocities change
-    by the moves over the step h (s)."""
+    planes, in up to ``passes`` Gauss-Seidel passes. A pair acts while the point lies over
+    its triangle (its closest point's offset within the triangle's plane is under
+    ``thickness``); each correction is split over the point and the triangle's corners by
+    inverse mass and barycentric weight (momentum kept) and capped at ``step`` (m). The
+    velocities change by the moves over the step h (s)."""
     x0 = x.copy()
     n, K = tri.shape
     for _ in range(passes):
@@ -193,7 +190,6 @@ def project(x, v, w, mesh, tri, side, thickness, step, planes, passes, h):
                     x[a, r] -= w[a] * u * dr
                     x[b, r] -= w[b] * vv * dr
                     x[c, r] -= w[c] * ww * dr
-        _keep_out(x, w, planes)
         if count == 0:
             break
     for p in range(n):
