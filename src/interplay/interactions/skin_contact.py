@@ -24,6 +24,10 @@ met in the run against the thinnest limb's radius; the runner's summary carries 
 
 The reaction (minus the cloth's momentum change per step) is logged on the figure as force
 and torque, never applied: the analysis's effective acceleration and the advisor read it.
+
+Garments worn in layers (systems/garment_layers.py) are held apart from each other and from
+themselves at the start of the projection, each point's sides told by the skin's normal and
+limb found for it the step before; the skin contact then has the last word.
 """
 from __future__ import annotations
 

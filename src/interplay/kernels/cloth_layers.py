@@ -23,7 +23,7 @@ a corner in it (the cloth's own curvature there is the bending springs' business
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .aabb_tree import STACK, _box_dist2
 from .trimesh_contact import closest_on_triangle
@@ -64,54 +64,53 @@ def _normal(x, a, b, c):
     return n0 / ln, n1 / ln, n2 / ln
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def gather(x, radius, tree, mesh, out_tri):
     """For each point, its K (out_tri's columns) nearest triangles within ``radius`` (m) with
-    no corner in its neighbourhood, nearest first (-1: none). Race-free: each point writes
-    only its own row."""
+    no corner in its neighbourhood, nearest first (-1: none). Serial: with prange it took the
+    same 21 ms at 12.5k points with the other core busy (docs/architecture.md: serial
+    kernels by default)."""
     n = x.shape[0]
     K = out_tri.shape[1]
     lo, hi, left, right, prim = tree
-    chunk = 256
-    for c in prange((n + chunk - 1) // chunk):
-        st = np.empty(STACK, np.int64)
-        best = np.empty(K)
-        near = np.zeros(n, np.bool_)  # the point's neighbourhood, marked while it is queried
-        for i in range(c * chunk, min(n, (c + 1) * chunk)):
-            for k in range(K):
-                out_tri[i, k] = -1
-                best[k] = radius * radius
-            for k in range(mesh.start[i], mesh.start[i + 1]):
-                near[mesh.nbr[k]] = True
-            p = x[i]
-            st[0] = 0
-            top = 1
-            while top > 0:
-                top -= 1
-                node = st[top]
-                if _box_dist2(p, lo, hi, node) > best[K - 1]:
-                    continue
-                e = prim[node]
-                if e < 0:
-                    st[top] = left[node]
-                    st[top + 1] = right[node]
-                    top += 2
-                    continue
-                ia, ib, ic = mesh.tris[e, 0], mesh.tris[e, 1], mesh.tris[e, 2]
-                if near[ia] or near[ib] or near[ic]:
-                    continue
-                u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
-                if d2 >= best[K - 1]:
-                    continue
-                k = K - 1
-                while k > 0 and best[k - 1] > d2:
-                    best[k] = best[k - 1]
-                    out_tri[i, k] = out_tri[i, k - 1]
-                    k -= 1
-                best[k] = d2
-                out_tri[i, k] = e
-            for k in range(mesh.start[i], mesh.start[i + 1]):
-                near[mesh.nbr[k]] = False
+    st = np.empty(STACK, np.int64)
+    best = np.empty(K)
+    near = np.zeros(n, np.bool_)  # the point's neighbourhood, marked while it is queried
+    for i in range(n):
+        for k in range(K):
+            out_tri[i, k] = -1
+            best[k] = radius * radius
+        for k in range(mesh.start[i], mesh.start[i + 1]):
+            near[mesh.nbr[k]] = True
+        p = x[i]
+        st[0] = 0
+        top = 1
+        while top > 0:
+            top -= 1
+            node = st[top]
+            if _box_dist2(p, lo, hi, node) > best[K - 1]:
+                continue
+            e = prim[node]
+            if e < 0:
+                st[top] = left[node]
+                st[top + 1] = right[node]
+                top += 2
+                continue
+            ia, ib, ic = mesh.tris[e, 0], mesh.tris[e, 1], mesh.tris[e, 2]
+            if near[ia] or near[ib] or near[ic]:
+                continue
+            u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
+            if d2 >= best[K - 1]:
+                continue
+            k = K - 1
+            while k > 0 and best[k - 1] > d2:
+                best[k] = best[k - 1]
+                out_tri[i, k] = out_tri[i, k - 1]
+                k -= 1
+            best[k] = d2
+            out_tri[i, k] = e
+        for k in range(mesh.start[i], mesh.start[i + 1]):
+            near[mesh.nbr[k]] = False
 
 
 @njit(cache=True)
