@@ -81,7 +81,10 @@ class Fit:
     length (-) of sleeves as a share of the upper arm, of a skirt as a share of the thigh;
     elastic (-): an elastic band's rest girth as a share of its cut girth; min_gap (m): the
     least distance from the body after fitting; flare (deg): a skirt's opening angle; split:
-    edges longer than this many spacings are split at their middle after sewing."""
+    edges longer than this many spacings are split at their middle after sewing; shortest:
+    edges shorter than this many spacings are lengthened after sewing (a tube that narrows,
+    a pants leg to its cuff, keeps its columns: its ring edges shorten with its girth, and
+    lengthened they buckle the ring over itself)."""
     spacing: float = param(0.018, "m", ge=0.004, le=0.1, cost=("points", -2))
     ease: float = param(0.02, "m", ge=0.0, le=0.3)
     band_ease: float = param(0.004, "m", ge=0.0, le=0.1)
@@ -90,6 +93,7 @@ class Fit:
     min_gap: float = param(0.008, "m", ge=0.0, le=0.05)
     flare: float = param(14.0, "deg", ge=0.0, le=60.0)
     split: float = param(1.6, "-", ge=1.2, le=10.0)
+    shortest: float = param(0.6, "-", ge=0.0, le=1.0)
 
 
 @dataclass
@@ -204,7 +208,7 @@ def _finish(name, b, surface, fabric, fit, groups, rings, sizes) -> Garment:
         # and where rows crowd (a crotch loop's chain beside the first leg row) edges come
         # out short: a short edge is a stiff spring that a millimetre's contact push strains
         # by tens of percent. Even the edges out towards [0.6, 1.6] spacings
-        x = even_out(x, t, 0.6 * fit.spacing, fit.split * fit.spacing)
+        x = even_out(x, t, fit.shortest * fit.spacing, fit.split * fit.spacing)
         # dressing's first step: nothing closer to the body than min_gap (against the skin's
         # triangles, which the cloth collides with: in a crease they stand off the smooth
         # body by a chord's sag)
@@ -404,7 +408,13 @@ def vest(surface: BodySurface, fit: Fit = Fit(), fabric: Fabric = FABRICS["cotto
     return _torso_body(surface, fit, fabric, False, name, over)
 
 
-def sweatpants(surface: BodySurface, fit: Fit = Fit(ease=0.025),
+#: the pants' cut: their legs narrow from the thigh to the ankle with the same columns, the
+#: cuffs' ring edges 0.5 spacings long; held to 0.6 spacings the cuffs' rings buckled over
+#: each other (66 crossing triangle pairs in the runner's cut, none at 0.3)
+PANTS_FIT = Fit(ease=0.025, shortest=0.3)
+
+
+def sweatpants(surface: BodySurface, fit: Fit = PANTS_FIT,
                fabric: Fabric = FABRICS["fleece"], name: str = "pants") -> Garment:
     """Sweat pants: a waistband (elastic) at the waist, the seat down to the crotch, two legs
     sewn to the crotch seam, elastic cuffs above the ankles."""

@@ -24,6 +24,10 @@ met in the run against the thinnest limb's radius; the runner's summary carries 
 
 The reaction (minus the cloth's momentum change per step) is logged on the figure as force
 and torque, never applied: the analysis's effective acceleration and the advisor read it.
+
+Garments worn in layers (systems/garment_layers.py) are held apart from each other and from
+themselves at the start of the projection, each point's sides told by the skin's normal and
+limb found for it the step before; the skin contact then has the last word.
 """
 from __future__ import annotations
 
@@ -83,9 +87,10 @@ class PosedSkin:
 
 class _Projector:
     """The projection of one cloth against a skin mesh (its triangles; X0 the skin's first
-    vertices for the tree), reused by SkinContact and by dressing."""
+    vertices for the tree; limbs (nb,) int64 each skin vertex's limb, for a garment worn in
+    layers), reused by SkinContact and by dressing."""
 
-    def __init__(self, cloth, tris, params: SkinContactParams, X0):
+    def __init__(self, cloth, tris, params: SkinContactParams, X0, limbs=None):
         self.view = cloth.contact_view()
         self.p = params
         self.tris = np.ascontiguousarray(tris, np.int64)
@@ -100,18 +105,31 @@ class _Projector:
         self.limiter = cloth if hasattr(cloth, "limit_strain") else None
         if self.limiter is not None:
             cloth.limit_by_contact = True
+        # garments worn in layers are held apart (systems/garment_layers.py), each point's
+        # side chosen at the step's start by the skin's normal and limb where it was found
+        self.layers = getattr(cloth, "layers", None)
+        self.limbs = (np.full(len(X0), -1, np.int64) if limbs is None
+                      else np.asarray(limbs, np.int64))
+        self.limb = np.full(n, -1, np.int64)  # each point's nearest skin point's limb
         self.approach = 0.0  # m: the deepest a point was found inside the skin
         self.count = 0
 
     def start(self):
         """Remember the points at the step's start (before the cloth advances)."""
         self.x0[:] = self.view.x
+        if self.layers is not None:
+            self.layers.start(self.n, self.limb)
 
     def resolve(self, X, V, h, centre=None):
         """Project the cloth against the skin (X, V) over a step h; (force, torque about
         centre) on the skin."""
-        self.tree.refit(X)
         v = self.view
+        if self.layers is not None:
+            # the layers first, so that the skin contact has the last word: where the body
+            # leaves no room for two layers (between the thighs) they touch rather than one
+            # being pushed into the skin (systems/garment_layers.py)
+            self.layers.project(h)
+        self.tree.refit(X)
         tri, d, bary = self.tree.nearest(v.x, self.p.thickness + self.p.reach)
         vertex_normals(X, self.tris, self.vn)
         signed_distance(v.x, tri, bary, d, X, self.tris, self.across, self.vn, self.s, self.n)
@@ -121,6 +139,7 @@ class _Projector:
         self.count = int(project(v.points, self.x0, Skin(X, V, self.tris),
                                  Nearest(tri, bary, self.s, self.n),
                                  Law(self.p.thickness, self.p.friction, h), self.dv))
+        self.limb[:] = np.where(tri >= 0, self.limbs[self.tris[tri, 0]], -1)
         if self.limiter is not None:
             # each point found near the skin keeps the thickness off its nearest point's
             # tangent plane: n . x >= n . x_now + thickness - max(s, thickness) (a point
@@ -163,7 +182,8 @@ class SkinContact(Interaction):
         self.p = params
         self.cloth, self.view = cloth, view
         self.skin = PosedSkin(figure, surface)
-        self.proj = _Projector(cloth, surface.triangles, params, self.skin.now()[0])
+        self.proj = _Projector(cloth, surface.triangles, params, self.skin.now()[0],
+                               surface.vertex_limbs())
         self._h = 0.0
         self._t = 0.0
         self.n_contacts = 0
@@ -209,8 +229,15 @@ class SkinContact(Interaction):
         return out
 
     def capture(self) -> dict:
-        return {"approach": np.array([self.proj.approach])}
+        out = {"approach": np.array([self.proj.approach])}
+        if self.proj.layers is not None:
+            # the next step's layer sides are told by the skin found at this step's end
+            out.update(normal=self.proj.n.copy(), limb=self.proj.limb.copy())
+        return out
 
     def restore(self, snap):
         if "approach" in snap:
             self.proj.approach = float(np.asarray(snap["approach"]).ravel()[0])
+        if "normal" in snap and self.proj.layers is not None:
+            self.proj.n[:] = snap["normal"]
+            self.proj.limb[:] = snap["limb"]

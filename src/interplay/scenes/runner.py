@@ -19,12 +19,13 @@ import numpy as np
 
 from ..geometry.body_surface import SurfaceParams, figure_surface
 from ..geometry.clearance import ClearanceParams
-from ..geometry.garment import Fit, join, network, sweatpants, tee
+from ..geometry.garment import PANTS_FIT, Fit, join, network, sweatpants, tee
 from ..interactions.mesh_contact import MeshContactParams, SelfContact
 from ..interactions.skin_contact import PosedSkin, SkinContact, SkinContactParams
 from ..outputs.render.camera import TrackingCamera
 from ..params import param
 from ..scene import Scene
+from ..systems.garment_layers import Layers
 from ..systems.garments import dress
 from ..systems.mocap import MocapFigure, check_clip, clip_path
 from .contract import SceneSpec
@@ -53,15 +54,18 @@ class RunnerParams:
     clearance: ClearanceParams = ClearanceParams(arms=ARM_ROOM)
     skin: SurfaceParams = SurfaceParams()
     tee: Fit = Fit(spacing=0.016)
-    pants: Fit = Fit(spacing=0.016, ease=0.025)
+    pants: Fit = replace(PANTS_FIT, spacing=0.016)
     contact: SkinContactParams = SkinContactParams()
     self_thickness: float = param(0.0, "m", ge=0.0, le=0.05)
+    layers: float = param(0.008, "m", ge=0.0, le=0.02, doc="0: the layers not held apart")
     cloth_dt: float = param(1.0 / 240.0, "s", ge=1e-5, le=0.02)
     lg_iterations: int = param(10, "iterations", ge=1, le=500)
     dress_s: float = param(0.0, "s", ge=0.0, le=10.0)
     settle_s: float = param(0.4, "s", ge=0.0, le=10.0)
 
 
+#: the limbs each garment is worn over (geometry.body_surface.LIMBS)
+COVERS = {"tee": ("trunk", "l_arm", "r_arm"), "pants": ("trunk", "l_leg", "r_leg")}
 TEE_COLOR = (0.62, 0.06, 0.05)  # linear RGB: a red tee
 PANTS_COLOR = (0.10, 0.11, 0.14)  # charcoal fleece
 
@@ -159,7 +163,7 @@ def _dressed(runner, params: RunnerParams, h: float, source: str):
         pants = sweatpants(surface, params.pants)
         shirt = tee(surface, params.tee, over=pants)
         clothes = join("clothes", pants, shirt)
-        net = _network(clothes, params, h)
+        net = _network(clothes, params, h, surface)
         runner.set_time(0.0)
         pos, R = runner.part_poses()
         selfc = None
@@ -176,19 +180,22 @@ def _dressed(runner, params: RunnerParams, h: float, source: str):
         _DRESSED.clear()
         _DRESSED[key] = (surface, clothes, shirt, pants, net.x.copy(), net.v.copy(), dressed)
     surface, clothes, shirt, pants, x, v, dressed = _DRESSED[key]
-    net = _network(clothes, params, h)
+    net = _network(clothes, params, h, surface)
     net.x[:], net.v[:] = x, v
     return surface, net, shirt, pants, dict(dressed)
 
 
-def _network(clothes, params, h):
+def _network(clothes, params, h, surface):
     colors = np.empty((len(clothes.vertices), 3))
     colors[clothes.groups["pants"]] = PANTS_COLOR
     colors[clothes.groups["tee"]] = TEE_COLOR
     # a spring caught in a pinch (an arm against the side) may strain far locally without
     # the cloth being unstable; the certificates report the stretch frame by frame
-    return network(clothes, dt=h, lg_iterations=params.lg_iterations, color=colors,
-                   strain_limit=20.0)
+    net = network(clothes, dt=h, lg_iterations=params.lg_iterations, color=colors,
+                  strain_limit=20.0)
+    if params.layers > 0:
+        net.layers = Layers(net, surface, params.layers, covers=COVERS)
+    return net
 
 
 def build(coupling: str = "one-way", duration: float = 1.4, fps: float = 30.0,

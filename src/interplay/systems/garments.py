@@ -85,6 +85,9 @@ class Garments(SpringNetwork):
         self._skin = None
         self.certificates: list = []
         self._own = None
+        # systems/garment_layers.Layers: the garments held apart from themselves and each
+        # other in the skin contact's projection (None: not)
+        self.layers = None
 
     def advance(self, h, dt=None):
         super().advance(h, dt)
@@ -242,6 +245,8 @@ class Garments(SpringNetwork):
         overstretched key's)."""
         snap = super().capture()
         snap["limit_stats"] = self.limit_stats.copy()
+        if self.layers is not None:
+            snap.update(self.layers.capture())
         c0 = self.certificates[0] if self.certificates else {"stretch": {}, "overstretched": {}}
         keys, share = sorted(c0["stretch"]), sorted(c0["overstretched"])
         rows = [[c["t"], c["cloth_body_intersections"], c["penetration_m"],
@@ -258,6 +263,9 @@ class Garments(SpringNetwork):
         rows, keys = snap.pop("cert", None), snap.pop("cert_keys", None)
         share = snap.pop("cert_share_keys", None)
         self.limit_stats[:] = snap.pop("limit_stats", np.zeros(3))
+        layers = {k: snap.pop(k) for k in ("layers_tri", "layers_age") if k in snap}
+        if self.layers is not None and layers:
+            self.layers.restore(layers)
         super().restore(snap)
         if rows is not None:
             keys = [str(k) for k in np.asarray(keys).ravel()]
@@ -299,7 +307,8 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
     from ..interactions.skin_contact import SkinContactParams, _Projector
     h = net.dt if h is None else h
     contact = SkinContactParams() if contact is None else contact
-    proj = _Projector(net, surface.triangles, contact, surface.vertices0)
+    proj = _Projector(net, surface.triangles, contact, surface.vertices0,
+                      surface.vertex_limbs())
     alpha = net.alpha
     net.alpha = alpha + damping
     steps_move = max(1, int(round(seconds / h))) if seconds > 0 else 1
