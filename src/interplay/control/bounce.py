@@ -72,7 +72,13 @@ class BounceParams:
     descent the hips are servoed on where the feet are, each tick's hip target the present
     angle turned by aim times the feet's miss over the leg's length (0: the placement is the
     open-loop leg angle above, blind to where the hips' servos leave the feet and to the
-    trunk's tilt carrying the centre of mass off the hips)."""
+    trunk's tilt carrying the centre of mass off the hips); on the bed sideways, where her ankles
+    have no roll joint to steer with, the hips shift the pelvis over the feet: k_side (rad/m)
+    of abduction per metre of the centre of mass's sideways lead over the soles and
+    k_side_drift (rad s/m) per m/s of its sideways speed (the landing's hip strategy,
+    control/landing.py), and k_roll (rad/m): the knee on the side she leans to straightens
+    and the other bends by k_roll times that lead; width (rad): each hip's abduction from
+    the descent on, the feet landing apart (0: together, as she flies)."""
     knee_land: float = param(
         0.24248216393047864, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
     lean: float = param(0.04123097909656632, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
@@ -88,7 +94,8 @@ class BounceParams:
         2.992458576628844, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
     arm_land: float = param(
         0.9753128714654313, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
-    k_speed: float = param(0.4406028934995885, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+    k_speed: float = param(
+        0.4406028934995885, "s", ge=0.0, le=5.0, doc="foot placement on speed")
     k_place: float = param(
         0.44176941099682676, "-", ge=0.0, le=5.0, doc="foot placement on offset")
     k_lead: float = param(2.1706362907687864, "rad/m", ge=0.0, le=50.0)
@@ -98,7 +105,15 @@ class BounceParams:
     k_turn: float = param(0.012788720878903427, "m s/(kg m^2)", ge=-1.0, le=1.0)
     k_hip_spin: float = param(-0.052252244425987575, "rad s/(kg m^2)", ge=-1.0, le=1.0)
     k_arms: float = param(0.3043088900154914, "-", ge=0.0, le=5.0)
-    aim: float = param(0.0, "-", ge=0.0, le=10.0, doc="the hips servoed on the feet's miss")
+    aim: float = param(
+        0.0, "-", ge=0.0, le=10.0, doc="the hips servoed on the feet's miss")
+    k_side: float = param(
+        0.0, "rad/m", ge=-20.0, le=20.0, doc="sideways hips on the lead")
+    k_side_drift: float = param(
+        0.0, "rad s/m", ge=-20.0, le=20.0, doc="on its speed")
+    width: float = param(0.0, "rad", ge=-0.5, le=0.75, doc="each hip's abduction, landing")
+    k_roll: float = param(
+        0.0, "rad/m", ge=-50.0, le=50.0, doc="knees on the sideways lead")
 
     def validated(self) -> "BounceParams":
         for f in fields(self):
@@ -120,7 +135,9 @@ BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4),
           "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6), "k_place": (0.0, 1.0),
           "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5), "k_spin": (0.0, 0.05),
           "k_attitude": (0.0, 1.2), "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
-          "k_arms": (0.0, 1.5), "aim": (0.0, 4.0)}
+          "k_arms": (0.0, 1.5), "aim": (0.0, 4.0), "k_side": (-2.0, 2.0),
+          "k_side_drift": (-2.0, 2.0), "width": (0.0, 0.3),
+          "k_roll": (-5.0, 10.0)}
 
 
 def controller(p: BounceParams) -> Controller:
@@ -138,7 +155,7 @@ def controller(p: BounceParams) -> Controller:
                                    ("toe", 0.0)),
                    transitions=(Transition("com_falling", "descend"),), blend=0.15)
     descend = State("descend", pose=(("hip_flex", 0.5 * p.knee_land + p.trunk),
-                                     ("hip_abd", 0.0), ("knee", p.knee_land),
+                                     ("hip_abd", p.width), ("knee", p.knee_land),
                                      ("ankle", 0.5 * p.knee_land + p.lean),
                                      ("shoulder_abd", p.arm_land), ("elbow", 0.1)),
                     gains=legs, support=True, blend=0.4,
@@ -177,6 +194,7 @@ class BounceBalance:
         self.shoulders = np.array([idx["l_shoulder_flex"], idx["r_shoulder_flex"]])
         self.arms = None  # kg m^2: the arms' inertia about the shoulders' axis (first tick)
         self.abd_l, self.abd_r = idx["l_hip_abd"], idx["r_hip_abd"]
+        self.knees = np.array([idx["l_knee"], idx["r_knee"]])
         self.out = np.zeros(len(joints))
 
     def capture(self) -> dict:
@@ -199,7 +217,8 @@ class BounceBalance:
         if len(fig.feet_touching()):
             # on the bed: the ankle strategy, steering the pressure under the feet to keep the
             # centre of mass over them and the body from rotating
-            lead = (com - d.geom_xpos[fig.sole_geoms].mean(axis=0)) @ fwd
+            rel = com - d.geom_xpos[fig.sole_geoms].mean(axis=0)
+            lead = rel @ fwd
             spin = d.subtree_angmom[fig.root] @ left  # > 0: pitching forward
             want[self.ankles] = -(p.k_lead * lead + p.k_drift * (v @ fwd) + p.k_spin * spin)
             # and the hips: flexed by the legs' lean, the pelvis is held upright over them
@@ -208,8 +227,11 @@ class BounceBalance:
             want[self.flex] = (p.k_attitude * math.atan2(leg @ fwd, -leg[2])
                                + p.k_hip_spin * spin)
             side = (p.k_attitude * math.atan2(leg @ left, -leg[2])
-                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd))
+                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd)
+                    + p.k_side * (rel @ left) + p.k_side_drift * (v @ left))
             want[self.abd_l], want[self.abd_r] = side, -side
+            # and the knees: the leg on the side she leans to straightens, the other bends
+            want[self.knees] = np.array([-1.0, 1.0]) * (p.k_roll * (rel @ left))
         else:
             # in the air: place the feet ahead of the centre of mass to brake and steer back,
             # the hips turned against the pelvis's pitch and roll so the legs aim in the world
