@@ -200,7 +200,7 @@ EDGES_BEST = {
 
 
 #: the first search on the bed's faces' best, with sharp feet: the start of the search with her
-#: feet rounded, whose best are the defaults now (docs/trampoline.md)
+#: feet rounded (search 4, whose best is ROUNDED_BEST; docs/trampoline.md)
 FACES_BEST = {
     "knee_land": 0.1,
     "lean": 0.013067336197741832,
@@ -221,6 +221,131 @@ FACES_BEST = {
     "k_turn": 0.0017583143699759665,
     "k_hip_spin": -0.048651496501968365,
     "k_arms": 0.23585735263605434}
+
+
+#: search 4's best (her feet rounded; the defaults until search 10): the start of search 5, on the
+#: penalty contact with the aim in the box (docs/trampoline.md)
+ROUNDED_BEST = {
+    "knee_land": 0.24248216393047864,
+    "lean": 0.04123097909656632,
+    "trunk": -0.15749223801622314,
+    "leg_omega": 12.039005719344434,
+    "ankle_share": 0.4787877610561425,
+    "thrust_delay": 0.10186381131316363,
+    "power": 0.3282547105673322,
+    "ankle_push": 0.2937119821651646,
+    "arm_swing": 2.992458576628844,
+    "arm_land": 0.9753128714654313,
+    "k_speed": 0.4406028934995885,
+    "k_place": 0.44176941099682676,
+    "k_lead": 2.1706362907687864,
+    "k_drift": 0.018015126063999506,
+    "k_spin": 0.01601819208919427,
+    "k_attitude": 0.14955399755798174,
+    "k_turn": 0.012788720878903427,
+    "k_hip_spin": -0.052252244425987575,
+    "k_arms": 0.3043088900154914}
+
+
+#: search 5's best, on the penalty contact: the start of search 6
+PENALTY_BEST = {
+    "knee_land": 0.12688073428741617,
+    "lean": 0.16132444824908726,
+    "trunk": -0.06790357045231446,
+    "leg_omega": 14.125699182935575,
+    "ankle_share": 0.42835246419845086,
+    "thrust_delay": 0.20241580986136984,
+    "power": 0.49368903761799376,
+    "ankle_push": 0.22319232804239644,
+    "arm_swing": 3.0714034199646014,
+    "arm_land": 0.4837484076881579,
+    "k_speed": 0.0106527949992883,
+    "k_place": 0.4224230775972595,
+    "k_lead": 4.598635519496023,
+    "k_drift": 0.5998448944256647,
+    "k_spin": 0.04484608380090811,
+    "k_attitude": 0.1714621698578907,
+    "k_turn": 0.007107471041100739,
+    "k_hip_spin": -0.03209944715517113,
+    "k_arms": 0.4865828151164402,
+    "aim": 0.6506881154713995}
+
+
+#: search 6's best: the start of search 7 (docs/trampoline.md)
+AIMED_BEST = {
+    "knee_land": 0.11485230175639055,
+    "lean": 0.1953273128847776,
+    "trunk": -0.0979983815576149,
+    "leg_omega": 15.448189777805759,
+    "ankle_share": 0.4478391818543865,
+    "thrust_delay": 0.29692977941723087,
+    "power": 0.4426029894362917,
+    "ankle_push": 0.21067526214394747,
+    "arm_swing": 3.011046109958195,
+    "arm_land": 0.7696353617190258,
+    "k_speed": 0.029170681999973434,
+    "k_place": 0.17954322818729754,
+    "k_lead": 4.725150609878495,
+    "k_drift": 0.8221084873666624,
+    "k_spin": 0.04416498014393186,
+    "k_attitude": 0.24704378327249002,
+    "k_turn": 0.005844314332778585,
+    "k_hip_spin": -0.02209927468628369,
+    "k_arms": 0.7386520068877024,
+    "aim": 0.7054225481355482}
+
+
+#: search 7's best (steady flights, 0.90-0.93 m; from every drop near the scene's she falls
+#: sideways at the 7th-9th landing): the start of search 9, with the sideways hips (k_side,
+#: k_side_drift) at zero
+STEADY_BEST = {
+    "knee_land": 0.14932903121522764,
+    "lean": 0.2108107741110194,
+    "trunk": -0.12789054439975936,
+    "leg_omega": 17.24217702532367,
+    "ankle_share": 0.5585378089183403,
+    "thrust_delay": 0.3,
+    "power": 0.47358617728102625,
+    "ankle_push": 0.27778627823774754,
+    "arm_swing": 2.773937463235526,
+    "arm_land": 0.8052451713027293,
+    "k_speed": 0.033077606985032974,
+    "k_place": 0.18872671896219803,
+    "k_lead": 4.975737781978708,
+    "k_drift": 1.1708866693277733,
+    "k_spin": 0.040928464202839895,
+    "k_attitude": 0.19224451375183957,
+    "k_turn": 0.0045958220016454054,
+    "k_hip_spin": -0.02701657519764187,
+    "k_arms": 0.6995026317658182,
+    "aim": 1.1881161784393899}
+
+
+#: search 9's best (the sideways hips in its box): the start of search 10, whose best are the
+#: defaults, with the landing's width and the knees' roll term at zero
+SIDE_BEST = {
+    "knee_land": 0.14944063544858793,
+    "lean": 0.21433967795390688,
+    "trunk": -0.12328451937787022,
+    "leg_omega": 17.131517267670294,
+    "ankle_share": 0.5501210560109899,
+    "thrust_delay": 0.3,
+    "power": 0.46815571039100884,
+    "ankle_push": 0.28492552623268846,
+    "arm_swing": 2.776335677749211,
+    "arm_land": 0.8106350241991717,
+    "k_speed": 0.04306074986335582,
+    "k_place": 0.18579111584303462,
+    "k_lead": 5.044544165808041,
+    "k_drift": 1.1789751554484078,
+    "k_spin": 0.04083634571109614,
+    "k_attitude": 0.1859750787253058,
+    "k_turn": 0.004302345373021194,
+    "k_hip_spin": -0.025550732755524955,
+    "k_arms": 0.7152400994189753,
+    "aim": 1.1512273902136345,
+    "k_side": 0.01674685786176071,
+    "k_side_drift": -0.0783104532316746}
 
 
 def start_sets(values: dict = HAND_START) -> list[str]:
