@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from .aabb_tree import STACK, _box_dist2
+from .skin_contact import _face_normal
 from .trimesh_contact import closest_on_triangle
 
 
@@ -45,23 +46,6 @@ class Body(NamedTuple):
     (n,) int64 that skin point belongs to (-1: none found near)."""
     nrm: np.ndarray
     limb: np.ndarray
-
-
-@njit(cache=True, inline="always")
-def _normal(x, a, b, c):
-    e0 = x[b, 0] - x[a, 0]
-    e1 = x[b, 1] - x[a, 1]
-    e2 = x[b, 2] - x[a, 2]
-    f0 = x[c, 0] - x[a, 0]
-    f1 = x[c, 1] - x[a, 1]
-    f2 = x[c, 2] - x[a, 2]
-    n0 = e1 * f2 - e2 * f1
-    n1 = e2 * f0 - e0 * f2
-    n2 = e0 * f1 - e1 * f0
-    ln = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-    if ln == 0.0:
-        return 0.0, 0.0, 0.0
-    return n0 / ln, n1 / ln, n2 / ln
 
 
 @njit(cache=True)
@@ -126,7 +110,7 @@ def sides(x, mesh, body, tri, out_side):
                 continue
             ia, ib, ic = mesh.tris[e, 0], mesh.tris[e, 1], mesh.tris[e, 2]
             u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
-            n0, n1, n2 = _normal(x, ia, ib, ic)
+            n0, n1, n2 = _face_normal(x, mesh.tris, e)
             li, lt = mesh.layer[i], mesh.layer[ia]
             ci, ct = mesh.limb[i], mesh.limb[ia]
             b = body.limb[i]
@@ -167,7 +151,7 @@ def project(x, v, w, mesh, tri, side, thickness, step, passes, h):
                     break
                 a, b, c = mesh.tris[e, 0], mesh.tris[e, 1], mesh.tris[e, 2]
                 u, vv, ww, d2 = closest_on_triangle(x[i], x[a], x[b], x[c])
-                n0, n1, n2 = _normal(x, a, b, c)
+                n0, n1, n2 = _face_normal(x, mesh.tris, e)
                 d0 = x[i, 0] - u * x[a, 0] - vv * x[b, 0] - ww * x[c, 0]
                 d1 = x[i, 1] - u * x[a, 1] - vv * x[b, 1] - ww * x[c, 1]
                 d2_ = x[i, 2] - u * x[a, 2] - vv * x[b, 2] - ww * x[c, 2]
