@@ -4,6 +4,7 @@ a block and a standing figure carried); the bounce state machine's contact event
 hybrid stand-in's coupling invariant; bad input. Slow: the default run's bounces, Table I
 and advice."""
 import json
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -461,6 +462,55 @@ def test_basin_search_scores_the_worst_of_nearby_drops(monkeypatch):
     assert sorted(seen) == [0.999, 1.0, 1.001]
     assert T.SPEC.search("bounce-basin").bounds == T.SPEC.search("bounce").bounds
 
+def test_mode_growth_factors_are_the_ratios_of_geometric_sequences():
+    """factors(): a sideways state a g^n (roll momentum and speed in the growing mode's ratio)
+    grows by exactly g a bounce; a fore-aft state c + b h^n (an orbit plus a perturbation
+    that the map scales by h) by exactly h; the drop's takeoff (n = 0) and states past LINEAR
+    are not counted."""
+    from interplay.control.bounce_modes import LINEAR, SWAY_ARM, factors
+    n = np.arange(7.0)
+    g, h = 0.6, 1.7
+    side = 1e-5 * g ** n
+    fore = 1e-4 * h ** n
+    modes = np.column_stack([side, side / SWAY_ARM, -0.2 + fore, 0.01 + 0.3 * fore / SWAY_ARM])
+    modes[0] = [0.3, 0.0, 0.21, 1.0]  # the drop's takeoff: anything
+    got_side, got_fore, counted = factors(modes)
+    assert got_side == pytest.approx(g, rel=1e-12) and got_fore == pytest.approx(h, rel=1e-12)
+    assert counted == 4  # fore-aft: 5 differences of takeoffs 1-6, 4 ratios
+    modes[4:, 0] = 2.0 * LINEAR[0] * 3.0 ** n[4:]  # turned nonlinear: not counted from there
+    s = np.hypot(modes[:, 0], SWAY_ARM * modes[:, 1])
+    expected = math.exp(math.log(s[4] / s[1]) / 3)  # s2/s1, s3/s2, s4/s3: s3 was small
+    assert factors(modes)[0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_growth_search_scores_the_worse_mode_and_a_fall(monkeypatch):
+    """The growth search's loss: log of the larger mode factor; one more per takeoff short of
+    the trial's (she fell); a mode never small enough to measure scores x e^3; its trial is
+    seeded sideways and stops at TAKEOFFS."""
+    from interplay.control import bounce_modes as BM
+    from interplay.control.bounce_search import BounceRecord
+    n = np.arange(7.0)
+    side, fore = 1e-5 * 0.5 ** n, 1e-4 * 1.5 ** n
+    rec = BounceRecord(modes=[list(r) for r in np.column_stack(
+        [side, 0 * n, -0.2 + fore, 0 * n])], takeoffs=[(t, 0, 0) for t in n],
+        apexes=[3.0] * 7, landings=[(0, 0, 0, 2.0, 0)] * 7)
+    asked = {}
+
+    def fake(params, coupling, duration, sideways=0.0, takeoffs=None):
+        asked.update(sideways=sideways, takeoffs=takeoffs)
+        return rec
+    monkeypatch.setattr(BM, "trial", fake)
+    kw = {"params": T.TrampolineParams(), "duration": 12.0}
+    assert BM.growth_loss("two-way", kw) == pytest.approx(math.log(1.5), rel=1e-12)
+    assert asked == {"sideways": BM.SIDE_SEED, "takeoffs": BM.TAKEOFFS}
+    rec.takeoffs, rec.modes = rec.takeoffs[:5], rec.modes[:5]  # fell after five
+    assert BM.growth_loss("two-way", kw) == pytest.approx(math.log(1.5) + 2, rel=1e-12)
+    for row in rec.modes:
+        row[0] = 1.0  # the sideways state never small
+    assert BM.growth_loss("two-way", kw) == pytest.approx(3.0 + 2, rel=1e-12)
+    assert set(T.SPEC.search("bounce-growth").bounds) <= set(T.SPEC.search("bounce").bounds)
+
+
 # --- the default run ----------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def default_run():
@@ -515,7 +565,8 @@ def test_a_touch_just_after_takeoff_continues_the_stance():
         def offsets(self, fig, s):
             return np.zeros(3)
     data = SimpleNamespace(xmat=np.eye(3).reshape(1, 9), ncon=0, subtree_angmom=np.zeros((1, 3)))
-    fig = SimpleNamespace(data=data, root=0, time=0.0, touched=np.zeros(1, bool))
+    fig = SimpleNamespace(data=data, root=0, time=0.0, touched=np.zeros(1, bool),
+                          heading_axes=lambda: (np.array([1.0, 0, 0]), np.array([0, 1.0, 0])))
     rec = BounceRecord()
     law = Recorded(Still(), rec)
     # air, stance, 1 tick off (well under GAP), stance, off for good, then a real landing
@@ -529,3 +580,4 @@ def test_a_touch_just_after_takeoff_continues_the_stance():
                           "hand_contact": False})
     assert [round(t, 3) for t, *_ in rec.landings] == [0.1, round(254 * dt, 3)]
     assert len(rec.takeoffs) == 1 and round(rec.takeoffs[0][0], 3) == round(104 * dt, 3)
+    assert len(rec.modes) == len(rec.takeoffs)  # the caught touch's takeoff state went too

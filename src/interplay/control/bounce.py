@@ -114,6 +114,11 @@ class BounceParams:
     width: float = param(0.0, "rad", ge=-0.5, le=0.75, doc="each hip's abduction, landing")
     k_roll: float = param(
         0.004119103424828045, "rad/m", ge=-50.0, le=50.0, doc="knees on the sideways lead")
+    k_speed_side: float = param(0.0, "s", ge=-5.0, le=5.0, doc="sideways placement on speed")
+    k_turn_side: float = param(
+        0.0, "m s/(kg m^2)", ge=-1.0, le=1.0, doc="sideways placement on the roll")
+    k_hip_roll: float = param(
+        0.0, "rad s/(kg m^2)", ge=-2.0, le=2.0, doc="sideways hips on the roll")
 
     def validated(self) -> "BounceParams":
         for f in fields(self):
@@ -135,9 +140,10 @@ BOUNDS = {"knee_land": (0.1, 0.9), "lean": (-0.1, 0.4), "trunk": (-0.2, 0.4),
           "arm_land": (0.0, 1.5), "k_speed": (0.0, 0.6), "k_place": (0.0, 1.0),
           "k_lead": (0.0, 6.0), "k_drift": (0.0, 1.5), "k_spin": (0.0, 0.05),
           "k_attitude": (0.0, 1.2), "k_turn": (0.0, 0.05), "k_hip_spin": (-0.06, 0.06),
-          "k_arms": (0.0, 1.5), "aim": (0.0, 4.0), "k_side": (-2.0, 2.0),
-          "k_side_drift": (-2.0, 2.0), "width": (0.0, 0.3),
-          "k_roll": (-5.0, 10.0)}
+          "k_arms": (0.0, 1.5), "aim": (0.0, 4.0), "k_side": (-1.0, 5.0),
+          "k_side_drift": (0.0, 8.0), "width": (0.0, 0.3),
+          "k_roll": (-8.0, 2.0), "k_speed_side": (-0.3, 0.3), "k_turn_side": (-0.01, 0.01),
+          "k_hip_roll": (-0.1, 0.1)}
 
 
 def controller(p: BounceParams) -> Controller:
@@ -227,7 +233,7 @@ class BounceBalance:
             want[self.flex] = (p.k_attitude * math.atan2(leg @ fwd, -leg[2])
                                + p.k_hip_spin * spin)
             side = (p.k_attitude * math.atan2(leg @ left, -leg[2])
-                    - p.k_hip_spin * (d.subtree_angmom[fig.root] @ fwd)
+                    - (p.k_hip_spin + p.k_hip_roll) * (d.subtree_angmom[fig.root] @ fwd)
                     + p.k_side * (rel @ left) + p.k_side_drift * (v @ left))
             want[self.abd_l], want[self.abd_r] = side, -side
             # and the knees: the leg on the side she leans to straightens, the other bends
@@ -241,7 +247,8 @@ class BounceBalance:
             c = com[:2] - self.centre
             spin = d.subtree_angmom[fig.root]  # kg m^2/s: forward pitch about +left
             turn_fwd = p.k_turn * (spin @ left)  # spinning forward: land with the feet ahead
-            turn_side = -p.k_turn * (spin @ fwd)  # rolling to her right: feet to the right
+            # rolling to her right: feet to the right
+            turn_side = -(p.k_turn + p.k_turn_side) * (spin @ fwd)
 
             def angle(a):
                 return float(np.clip(math.asin(np.clip(a / LEG_LENGTH, -1.0, 1.0)),
@@ -249,7 +256,8 @@ class BounceBalance:
             tilt = PLACE_MAX
             # m: where the feet should land, ahead of and left of the centre of mass
             fore = p.k_speed * (v[:2] @ fwd[:2]) + p.k_place * (c @ fwd[:2]) + turn_fwd
-            aside = p.k_speed * (v[:2] @ left[:2]) + p.k_place * (c @ left[:2]) + turn_side
+            aside = ((p.k_speed + p.k_speed_side) * (v[:2] @ left[:2])
+                     + p.k_place * (c @ left[:2]) + turn_side)
             want[self.flex] = angle(fore) + float(np.clip(pitch, -tilt, tilt))
             want[self.abd_l] = angle(aside) - float(np.clip(roll, -tilt, tilt))
             want[self.abd_r] = -want[self.abd_l]

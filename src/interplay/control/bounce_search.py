@@ -33,9 +33,12 @@ class BounceRecord:
     the centre of mass at touchdown, apexes (m, its highest point in each flight before a
     landing, the first the drop's), the largest tilt (rad), and whether she touched the
     floor; takeoffs [(t s, horizontal speed m/s, |angular momentum| kg m^2/s)] as each flight
-    begins."""
+    begins, and modes [(roll momentum about her forward axis, kg m^2/s; sideways speed, m/s;
+    pitch momentum about her left, kg m^2/s; forward speed, m/s)] of her centre of mass then:
+    the sideways and fore-aft modes' states (control/bounce_modes.py)."""
     landings: list = field(default_factory=list)
     takeoffs: list = field(default_factory=list)
+    modes: list = field(default_factory=list)
     apexes: list = field(default_factory=list)
     max_tilt: float = 0.0
     floor: bool = False
@@ -71,6 +74,7 @@ class Recorded:
                 # the recoiling bed caught her toes just after takeoff: the stance goes on
                 # (as in the contact log's episodes, record_of)
                 r.takeoffs.pop()
+                r.modes.pop()
                 r._air = False
             elif touching:
                 r.apexes.append(r._top)
@@ -82,6 +86,10 @@ class Recorded:
             v = sensors["com_vel"]
             r.takeoffs.append((fig.time, float(np.hypot(v[0], v[1])),
                                float(np.linalg.norm(fig.data.subtree_angmom[fig.root]))))
+            fwd, left = fig.heading_axes()
+            spin = fig.data.subtree_angmom[fig.root]
+            r.modes.append((float(spin @ fwd), float(v @ left), float(spin @ left),
+                            float(v @ fwd)))
         return self.inner.offsets(fig, sensors)
 
 
@@ -89,13 +97,16 @@ class _Fallen(Exception):
     pass
 
 
-def trial(params, coupling: str = "two-way", duration: float = DURATION) -> BounceRecord:
+def trial(params, coupling: str = "two-way", duration: float = DURATION,
+          sideways: float = 0.0, takeoffs: int | None = None) -> BounceRecord:
     """Run the trampoline scene with scene parameters ``params`` (TrampolineParams) and log
     the gymnast's bounces; stops early when she has fallen (tilt past TILT_FALLEN, the floor,
-    or out of the bed's central zone)."""
+    or out of the bed's central zone), or after ``takeoffs`` takeoffs when given. sideways
+    (m/s): a sideways speed she is dropped with (a probe of the sideways mode)."""
     from ..scenes.trampoline import CENTRE_ZONE, build
     scene = build(coupling, duration=duration, fps=10.0, params=params)
     fig = scene.primary
+    fig.data.qvel[:3] += sideways * fig.heading_axes()[1]
     record = BounceRecord()
     fig.feedback = Recorded(fig.feedback, record)
     zx, zy = CENTRE_ZONE
@@ -104,6 +115,8 @@ def trial(params, coupling: str = "two-way", duration: float = DURATION) -> Boun
         c = fig.com()
         if record.max_tilt > TILT_FALLEN or record.floor or abs(c[0]) > zx or abs(c[1]) > zy:
             raise _Fallen()
+        if takeoffs is not None and len(record.takeoffs) >= takeoffs:
+            raise _Fallen()  # seen enough
     try:
         scene.simulate(progress=watch, primary_only=coupling != "two-way")
     except _Fallen:

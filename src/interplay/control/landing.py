@@ -156,7 +156,8 @@ class LandingBalance(BounceBalance):
         bp = BounceParams(k_speed=p.k_speed, k_place=0.0, k_lead=p.k_lead, k_drift=p.k_drift,
                           k_spin=p.k_spin, k_attitude=p.k_attitude, k_turn=0.0,
                           k_hip_spin=p.k_hip_spin, k_arms=0.0, aim=0.0, k_side=0.0,
-                          k_side_drift=0.0, k_roll=0.0)  # sideways: its own, below
+                          k_side_drift=0.0, k_roll=0.0, k_speed_side=0.0,
+                          k_turn_side=0.0, k_hip_roll=0.0)  # sideways: its own, below
         super().__init__(bp, joints)
         self.k_side, self.k_side_drift = p.k_side, p.k_side_drift
         self.side = 0.0  # rad: the sideways hip offset now

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..control.bounce import BounceBalance, BounceParams, controller
+from ..control.bounce_modes import GROWTH
 from ..control.bounce_search import BASIN, BOUNCE
 from ..outputs.render.camera import Camera
 from ..geometry.anthropometry import BodyParams
@@ -214,6 +215,6 @@ def figures(result) -> dict:
 SPEC = SceneSpec(
     "trampoline", "a gymnast bounces on a spring-mass trampoline (two-way)", build,
     TrampolineParams, couplings=("two-way", "hybrid", "one-way"), duration=20.0, fps=60.0,
-    integrators=("explicit",), searches=(BOUNCE, BASIN), figures=figures,
+    integrators=("explicit",), searches=(BOUNCE, BASIN, GROWTH), figures=figures,
     camera=Camera((2.6, -7.6, 2.6), (0.0, 0.0, 1.8), 40.0), key_time=0.65, heavy=True,
     warm_time=0.5)  # she lands at 0.45 s
