@@ -542,9 +542,6 @@ def test_default_run_matches_table_i_and_the_bed_band(default_run):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 15's bar, not met yet: the shipped controller "
-                   "(search 10, docs/trampoline.md) lands upright 9 times, its flights within "
-                   "6.9%, then falls sideways; remove this mark when it passes")
 def test_default_run_bounces_ten_times(default_run):
     """At least 10 good bounces in a row in the central zone, the flight heights after the
     second within 10% ((max - min) / mean)."""

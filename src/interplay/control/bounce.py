@@ -80,45 +80,47 @@ class BounceParams:
     and the other bends by k_roll times that lead; width (rad): each hip's abduction from
     the descent on, the feet landing apart (0: together, as she flies)."""
     knee_land: float = param(
-        0.14955291912535282, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
-    lean: float = param(0.21410317625280054, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
-    trunk: float = param(-0.12009770683850916, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
+        0.1424226959213322, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
+    lean: float = param(0.20698593380938535, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
+    trunk: float = param(-0.1351097518235242, "rad", ge=-1.0, le=1.5, doc="extra hip flexion")
     leg_omega: float = param(
-        17.217810104363537, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
+        17.29121847458241, "rad/s", gt=0.0, le=100.0, doc="stance servo frequency")
     ankle_share: float = param(
-        0.5412151404002863, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
-    thrust_delay: float = param(0.29590796976707784, "s", ge=0.0, le=2.0, doc="after touchdown")
-    power: float = param(0.475055096469051, "-", gt=0.0, le=5.0, doc="the extension's speed")
-    ankle_push: float = param(0.2837507334131653, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
+        0.5098146189903848, "-", gt=0.0, le=2.0, doc="ankles' share of leg_omega")
+    thrust_delay: float = param(0.2930074239134891, "s", ge=0.0, le=2.0, doc="after touchdown")
+    power: float = param(0.5783727889949792, "-", gt=0.0, le=5.0, doc="the extension's speed")
+    ankle_push: float = param(0.2713425921382224, "rad", ge=-1.0, le=0.6, doc="ankle at takeoff")
     arm_swing: float = param(
-        2.763718128566324, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
+        2.706300621605705, "rad", ge=0.0, le=3.2, doc="shoulder abduction, takeoff")
     arm_land: float = param(
-        0.8165356126476446, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
+        0.9417450686491842, "rad", ge=0.0, le=3.2, doc="shoulder abduction, landing")
     k_speed: float = param(
-        0.049960744495031614, "s", ge=0.0, le=5.0, doc="foot placement on speed")
+        0.020480619970776732, "s", ge=0.0, le=5.0, doc="foot placement on speed")
     k_place: float = param(
-        0.16645562437142422, "-", ge=0.0, le=5.0, doc="foot placement on offset")
-    k_lead: float = param(5.056711983977513, "rad/m", ge=0.0, le=50.0)
-    k_drift: float = param(1.1914239063991712, "rad s/m", ge=0.0, le=20.0)
-    k_spin: float = param(0.042032027454567016, "rad s/(kg m^2)", ge=0.0, le=1.0)
-    k_attitude: float = param(0.1791730989980489, "-", ge=0.0, le=3.0)
-    k_turn: float = param(0.0048070815189191814, "m s/(kg m^2)", ge=-1.0, le=1.0)
-    k_hip_spin: float = param(-0.025185525129380465, "rad s/(kg m^2)", ge=-1.0, le=1.0)
-    k_arms: float = param(0.6894319229289314, "-", ge=0.0, le=5.0)
+        0.23091748549548033, "-", ge=0.0, le=5.0, doc="foot placement on offset")
+    k_lead: float = param(4.8181943941287235, "rad/m", ge=0.0, le=50.0)
+    k_drift: float = param(1.1785864179627352, "rad s/m", ge=0.0, le=20.0)
+    k_spin: float = param(0.043532118254619445, "rad s/(kg m^2)", ge=0.0, le=1.0)
+    k_attitude: float = param(0.20039058361221426, "-", ge=0.0, le=3.0)
+    k_turn: float = param(0.004144061806616518, "m s/(kg m^2)", ge=-1.0, le=1.0)
+    k_hip_spin: float = param(-0.03455440288576774, "rad s/(kg m^2)", ge=-1.0, le=1.0)
+    k_arms: float = param(0.670278510898547, "-", ge=0.0, le=5.0)
     aim: float = param(
-        1.2211224295251615, "-", ge=0.0, le=10.0, doc="the hips servoed on the feet's miss")
+        1.2391029812565044, "-", ge=0.0, le=10.0, doc="the hips servoed on the feet's miss")
     k_side: float = param(
-        0.039228197090094265, "rad/m", ge=-20.0, le=20.0, doc="sideways hips on the lead")
+        1.8443404812826967, "rad/m", ge=-20.0, le=20.0, doc="sideways hips on the lead")
     k_side_drift: float = param(
-        -0.04292187973416589, "rad s/m", ge=-20.0, le=20.0, doc="on its speed")
-    width: float = param(0.0, "rad", ge=-0.5, le=0.75, doc="each hip's abduction, landing")
+        4.081760045683858, "rad s/m", ge=-20.0, le=20.0, doc="on its speed")
+    width: float = param(
+        0.01284751283714039, "rad", ge=-0.5, le=0.75, doc="each hip's abduction, landing")
     k_roll: float = param(
-        0.004119103424828045, "rad/m", ge=-50.0, le=50.0, doc="knees on the sideways lead")
-    k_speed_side: float = param(0.0, "s", ge=-5.0, le=5.0, doc="sideways placement on speed")
+        -3.2997047394784764, "rad/m", ge=-50.0, le=50.0, doc="knees on the sideways lead")
+    k_speed_side: float = param(
+        0.032003794831570655, "s", ge=-5.0, le=5.0, doc="sideways placement on speed")
     k_turn_side: float = param(
-        0.0, "m s/(kg m^2)", ge=-1.0, le=1.0, doc="sideways placement on the roll")
+        0.0017048954315904547, "m s/(kg m^2)", ge=-1.0, le=1.0, doc="sideways placement, roll")
     k_hip_roll: float = param(
-        0.0, "rad s/(kg m^2)", ge=-2.0, le=2.0, doc="sideways hips on the roll")
+        0.032831302149056774, "rad s/(kg m^2)", ge=-2.0, le=2.0, doc="sideways hips on the roll")
 
     def validated(self) -> "BounceParams":
         for f in fields(self):

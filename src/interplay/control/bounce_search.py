@@ -361,6 +361,47 @@ SIDE_BEST = {
     "k_side_drift": -0.0783104532316746}
 
 
+#: search 10's best (the landing's width and the knees' roll term in its box; the defaults
+#: until search 13): with SIDEWAYS_START, the start of search 13 (docs/trampoline.md)
+WIDTH_BEST = {
+    "knee_land": 0.14955291912535282,
+    "lean": 0.21410317625280054,
+    "trunk": -0.12009770683850916,
+    "leg_omega": 17.217810104363537,
+    "ankle_share": 0.5412151404002863,
+    "thrust_delay": 0.29590796976707784,
+    "power": 0.475055096469051,
+    "ankle_push": 0.2837507334131653,
+    "arm_swing": 2.763718128566324,
+    "arm_land": 0.8165356126476446,
+    "k_speed": 0.049960744495031614,
+    "k_place": 0.16645562437142422,
+    "k_lead": 5.056711983977513,
+    "k_drift": 1.1914239063991712,
+    "k_spin": 0.042032027454567016,
+    "k_attitude": 0.1791730989980489,
+    "k_turn": 0.0048070815189191814,
+    "k_hip_spin": -0.025185525129380465,
+    "k_arms": 0.6894319229289314,
+    "aim": 1.2211224295251615,
+    "k_side": 0.039228197090094265,
+    "k_side_drift": -0.04292187973416589,
+    "width": 0.0,
+    "k_roll": 0.004119103424828045}
+
+
+#: the sideways gains search 13 started from: a Nelder-Mead on the modes' growth
+#: (control/bounce_modes.py) over these six, on search 10's best, brought the sideways factor from
+#: x19 to x2.6 a bounce (docs/trampoline.md, "The modes' growth")
+SIDEWAYS_START = {
+    "k_side": 1.987,
+    "k_side_drift": 4.8641,
+    "k_roll": -3.2486,
+    "k_hip_roll": 0.0391,
+    "k_turn_side": 0.0012,
+    "k_speed_side": 0.0145}
+
+
 def start_sets(values: dict = HAND_START) -> list[str]:
     """``--set`` items that put the search's start at ``values`` ({controller field: value})."""
     return [f"bounce.{k}={v!r}" for k, v in values.items()]
