@@ -78,7 +78,10 @@ class BounceParams:
     k_side_drift (rad s/m) per m/s of its sideways speed (the landing's hip strategy,
     control/landing.py), and k_roll (rad/m): the knee on the side she leans to straightens
     and the other bends by k_roll times that lead; width (rad): each hip's abduction from
-    the descent on, the feet landing apart (0: together, as she flies)."""
+    the descent on, the feet landing apart (0: together, as she flies); sideways gains of
+    their own on top of the shared ones: k_speed_side (s) adds to k_speed and k_turn_side
+    (m s/(kg m^2)) to k_turn in the sideways placement, k_hip_roll (rad s/(kg m^2)) to
+    k_hip_spin in the hips' answer to the roll on the bed (0: the shared gains alone)."""
     knee_land: float = param(
         0.1424226959213322, "rad", ge=0.0, le=2.0, doc="knee flexion at landing")
     lean: float = param(0.20698593380938535, "rad", ge=-1.0, le=1.0, doc="extra ankle flexion")
