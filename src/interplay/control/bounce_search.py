@@ -93,8 +93,8 @@ class Recorded:
         return self.inner.offsets(fig, sensors)
 
 
-class _Fallen(Exception):
-    pass
+class _Stop(Exception):
+    """A trial ends early: she fell, or the takeoffs asked for are in."""
 
 
 def trial(params, coupling: str = "two-way", duration: float = DURATION,
@@ -114,12 +114,12 @@ def trial(params, coupling: str = "two-way", duration: float = DURATION,
     def watch(p, t, wall, done=False):
         c = fig.com()
         if record.max_tilt > TILT_FALLEN or record.floor or abs(c[0]) > zx or abs(c[1]) > zy:
-            raise _Fallen()
+            raise _Stop()
         if takeoffs is not None and len(record.takeoffs) >= takeoffs:
-            raise _Fallen()  # seen enough
+            raise _Stop()  # seen enough
     try:
         scene.simulate(progress=watch, primary_only=coupling != "two-way")
-    except _Fallen:
+    except _Stop:
         pass
     return record
 
