@@ -460,8 +460,9 @@ def test_the_keyframed_run_is_a_clip_the_figure_plays(tmp_path):
 @pytest.mark.slow
 def test_the_runners_garments_never_cross_or_enter_the_body():
     """The issue's per-frame certificates on the default runner (43 frames of the CMU jog):
-    no cloth triangle crosses a skin triangle (the exact triangle-triangle test) and no cloth
-    point is more than 2 mm inside the skin, in any frame. Zero crossings needs the arms'
+    no cloth triangle crosses a skin triangle or another cloth triangle (the exact
+    triangle-triangle test) and no cloth point is more than 2 mm inside the skin, in any
+    frame. Zero crossings needs the arms'
     room for the hem (scenes/runner.ARM_ROOM: with 2 cm the hands crossed the tee's hem in 7
     frames)."""
     if not clip_path("cmu_02_03_run.bvh").exists():
@@ -473,6 +474,9 @@ def test_the_runners_garments_never_cross_or_enter_the_body():
     crossing = [f["cloth_body_intersections"] for f in frames]
     assert max(crossing) == 0, crossing
     assert max(f["penetration_m"] for f in frames) <= 0.002
+    # nor any garment triangle another (the layers' untangling and guard)
+    selfx = [f["self_intersections"] for f in frames]
+    assert max(selfx) == 0, selfx
 
 
 def _layered(surface, layers: bool, seconds: float = 0.25):

@@ -27,7 +27,11 @@ from numba import njit
 
 from .aabb_tree import STACK, _box_dist2
 from .skin_contact import _face_normal
-from .trimesh_contact import closest_on_triangle
+from .trimesh_contact import _edge_hits, _orient, closest_on_triangle
+
+
+#: ``forced``'s mark for a pair whose side is no guide (untangle): held neither way
+IGNORE = 2.0
 
 
 class Mesh(NamedTuple):
@@ -98,9 +102,10 @@ def gather(x, radius, tree, mesh, out_tri):
 
 
 @njit(cache=True)
-def sides(x, mesh, body, tri, out_side):
+def sides(x, mesh, body, tri, forced, out_side):
     """The side (+1, -1) each point is to stay on of each of its triangles ``tri`` (n,K)
-    (see the module docstring)."""
+    (see the module docstring); ``forced`` (n,K): where the body cannot tell, the side
+    ``untangle`` found for a point that has crossed its triangle (0: none)."""
     n, K = tri.shape
     for i in range(n):
         p = x[i]
@@ -125,6 +130,10 @@ def sides(x, mesh, body, tri, out_side):
                 # sleeve against the side): going out from a limb's skin its own cloth
                 # comes first, whichever of the two the point is nearest
                 out_side[i, k] = -outward if b == ci else outward
+            elif forced[i, k] == IGNORE:
+                out_side[i, k] = 0.0
+            elif forced[i, k] != 0.0:
+                out_side[i, k] = forced[i, k]
             else:
                 s = (n0 * (p[0] - u * x[ia, 0] - v * x[ib, 0] - w * x[ic, 0])
                      + n1 * (p[1] - u * x[ia, 1] - v * x[ib, 1] - w * x[ic, 1])
@@ -133,13 +142,17 @@ def sides(x, mesh, body, tri, out_side):
 
 
 @njit(cache=True)
-def project(x, v, w, mesh, tri, side, thickness, step, passes, h):
+def project(x, v, w, mesh, tri, side, forced, thickness, margin, step, passes, h):
     """Hold every point on its side of its candidate triangles, ``thickness`` (m) off their
-    planes, in up to ``passes`` Gauss-Seidel passes. A pair acts while the point lies over
-    its triangle (its closest point's offset within the triangle's plane is under
-    ``thickness``); each correction is split over the point and the triangle's corners by
-    inverse mass and barycentric weight (momentum kept) and capped at ``step`` (m). The
-    velocities change by the moves over the step h (s)."""
+    planes, in up to ``passes`` Gauss-Seidel passes; a crossed pair (``forced`` +-1: see
+    ``untangle``) only ``margin`` (m) through. A pair acts while the point lies over its
+    triangle (its closest point's offset within the triangle's plane is under
+    ``thickness``), a crossed pair wherever the point is: its edge through the triangle may
+    pass near the rim while the point itself lies beside it, and once the point is on the
+    plane's other side that edge no longer crosses. A pair marked IGNORE (side 0) does not
+    act. Each correction is split over the point and the triangle's corners by inverse mass
+    and barycentric weight (momentum kept) and capped at ``step`` (m). The velocities change
+    by the moves over the step h (s)."""
     x0 = x.copy()
     n, K = tri.shape
     for _ in range(passes):
@@ -156,10 +169,13 @@ def project(x, v, w, mesh, tri, side, thickness, step, passes, h):
                 d1 = x[i, 1] - u * x[a, 1] - vv * x[b, 1] - ww * x[c, 1]
                 d2_ = x[i, 2] - u * x[a, 2] - vv * x[b, 2] - ww * x[c, 2]
                 s = n0 * d0 + n1 * d1 + n2 * d2_
-                if d2 - s * s > thickness * thickness:
-                    continue  # beside the triangle, not over it
                 sg = side[i, k]
-                gap = thickness - sg * s
+                if sg == 0.0:
+                    continue
+                crossed = sg == forced[i, k]  # a side untangle chose (not the body's rule)
+                if d2 - s * s > thickness * thickness and not crossed:
+                    continue  # beside the triangle, not over it
+                gap = (margin if crossed else thickness) - sg * s
                 if gap <= 0.0:
                     continue
                 den = w[i] + u * u * w[a] + vv * vv * w[b] + ww * ww * w[c]
@@ -179,3 +195,66 @@ def project(x, v, w, mesh, tri, side, thickness, step, passes, h):
         if w[p] > 0.0:
             for r in range(3):
                 v[p, r] += (x[p, r] - x0[p, r]) / h
+
+
+@njit(cache=True)
+def untangle(x, mesh, pairs, tri, forced):
+    """The sides that undo crossings: ``pairs`` (k,2) are the garments' triangle pairs that
+    intersect (no shared corner). Each edge of one that passes through the other has one end
+    on the wrong side of it: the end nearer its plane (a crossing is made by a point slipping
+    a little way through between two gatherings, so the shallow end is the one that went
+    through; a local version of Baraff, Witkin & Kass 2003, "Untangling cloth", which flood
+    fills the region inside each intersection curve). That end gets the triangle as a
+    candidate (in place of its farthest one without a forced side) and, in ``forced``, the
+    side of the edge's other end (+1 along the triangle's normal). Skipped where the triangle
+    has a corner in the end's neighbourhood (the bending springs' business there). ``forced``
+    is cleared first; it returns the number of ends given a side."""
+    forced[:] = 0.0
+    K = tri.shape[1]
+    count = 0
+    for j in range(pairs.shape[0]):
+        for o in range(2):
+            ea, eb = pairs[j, o], pairs[j, 1 - o]
+            a, b, c = mesh.tris[eb, 0], mesh.tris[eb, 1], mesh.tris[eb, 2]
+            for r in range(3):
+                p, q = mesh.tris[ea, r], mesh.tris[ea, (r + 1) % 3]
+                if not _edge_hits(x[p], x[q], x[a], x[b], x[c]):
+                    continue
+                op, oq = _orient(x[a], x[b], x[c], x[p]), _orient(x[a], x[b], x[c], x[q])
+                end, other = (p, oq) if abs(op) < abs(oq) else (q, op)
+                if other == 0.0:
+                    continue
+                slot = -1
+                for k in range(K):
+                    if tri[end, k] == eb:
+                        slot = k
+                if slot < 0:  # the first empty slot (the candidates stay contiguous)
+                    for k in range(K):
+                        if tri[end, k] < 0:
+                            slot = k
+                            break
+                if slot < 0:  # else the farthest candidate without a forced side
+                    for k in range(K - 1, -1, -1):
+                        if forced[end, k] == 0.0:
+                            slot = k
+                            break
+                if slot < 0:
+                    continue
+                tri[end, slot] = eb
+                forced[end, slot] = 1.0 if other > 0.0 else -1.0
+                count += 1
+    # the side a point is on of a crossed triangle is no guide near the crossing: a corner
+    # of a crossed triangle holds no other side of one
+    crossed = np.zeros(mesh.tris.shape[0], np.bool_)
+    corner = np.zeros(x.shape[0], np.bool_)
+    for j in range(pairs.shape[0]):
+        for o in range(2):
+            crossed[pairs[j, o]] = True
+            for r in range(3):
+                corner[mesh.tris[pairs[j, o], r]] = True
+    for i in range(x.shape[0]):
+        if corner[i]:
+            for k in range(K):
+                if tri[i, k] >= 0 and forced[i, k] == 0.0 and crossed[tri[i, k]]:
+                    forced[i, k] = IGNORE
+    return count

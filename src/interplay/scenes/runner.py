@@ -37,6 +37,16 @@ from .contract import SceneSpec
 # CMU jog: 2 cm left the hands crossing the hem in 7 of 43 frames, 3 cm in 4, 4 cm in none
 # (docs/clothing.md)
 ARM_ROOM = 0.04
+# m: the gap her legs keep off each other. Two layers of pants between the thighs, each kept
+# 5 mm off the skin and 8 mm off the other: at 1 cm the guard against crossings (systems/
+# garment_layers.Layers.guard) held them pinched there and the left leg's springs strained
+# 2.7x; at 2 cm 1.2x at worst (docs/clothing.md)
+LEG_ROOM = 0.02
+# s: dressing moves the skin from the A-pose to the first pose while the garments follow, no
+# new crossing let through; carried there at once by the skin's weights they crossed
+# themselves 553 times, and carried through 40 poses between with the guard on, they were
+# held in zones 5 cm off where the weights put them, and the settle could not relax them
+DRESS_S = 0.4
 
 
 @dataclass(frozen=True)
@@ -51,7 +61,7 @@ class RunnerParams:
     skin's weights at once), settle_s (s): then settling on the still body, before t = 0."""
     clip: str = param("cmu_02_03_run.bvh", check=check_clip,
                       doc="a BVH clip in the mocap folder or a path; empty: keyframes")
-    clearance: ClearanceParams = ClearanceParams(arms=ARM_ROOM)
+    clearance: ClearanceParams = ClearanceParams(arms=ARM_ROOM, legs=LEG_ROOM)
     skin: SurfaceParams = SurfaceParams()
     tee: Fit = Fit(spacing=0.016)
     pants: Fit = replace(PANTS_FIT, spacing=0.016)
@@ -60,7 +70,7 @@ class RunnerParams:
     layers: float = param(0.008, "m", ge=0.0, le=0.02, doc="0: the layers not held apart")
     cloth_dt: float = param(1.0 / 240.0, "s", ge=1e-5, le=0.02)
     lg_iterations: int = param(10, "iterations", ge=1, le=500)
-    dress_s: float = param(0.0, "s", ge=0.0, le=10.0)
+    dress_s: float = param(DRESS_S, "s", ge=0.0, le=10.0)
     settle_s: float = param(0.4, "s", ge=0.0, le=10.0)
 
 

@@ -18,6 +18,18 @@ The thickness (8 mm on the runner) is far more than the fabrics' (0.6-2 mm): the
 is point-triangle only, and with edges 1.4-1.6 cm long two layers' edges slip through each
 other between points kept a few millimetres apart; half a spacing keeps most of them apart
 (docs/clothing.md: the runner's self-crossings at 1.5, 3, 5, 8 and 12 mm).
+
+That alone left 200-400 crossing triangle pairs a frame on the runner, 98% of them between
+triangles within two edges of each other (tight folds the point-triangle pairs leave out),
+made afresh every step by the cloth's own solve. Two things make it zero:
+- **Untangling** (kernels/cloth_layers.untangle): a point whose edge has gone through a
+  triangle is moved back through it, ``MARGIN`` beyond (the cut's own few crossings at the
+  crotch are gone within the first steps of the dressing).
+- **The guard** (``guard``, last in the step, kernels/impact_zones.py): no triangle pair that
+  did not cross at the step's start crosses at its end; the points of those that do move as
+  zones, first with the skin under them, then rigidly (Provot 1997; Bridson, Fedkiw &
+  Anderson 2002), which cannot cross. The zones' rims stretch: the stretch limit runs again
+  after the guard, and the guard once more (interactions/skin_contact._Projector.resolve).
 """
 from __future__ import annotations
 
@@ -29,6 +41,7 @@ from ..errors import ParameterError
 from ..geometry.aabb_tree import AABBTree
 from ..geometry.body_surface import LIMBS
 from ..kernels import cloth_layers as CL
+from ..kernels import impact_zones as IZ
 
 #: candidate triangles kept per point: a point between two folds of one garment and the
 #: other garment meets three
@@ -36,6 +49,15 @@ CANDIDATES = 4
 #: the candidates are gathered every REFRESH steps (the tree query is most of the layers'
 #: cost), their sides every step: within the radius's reach over two steps of 1/240 s
 REFRESH = 2
+#: rounds of growing the impact zones at most (guard)
+ZONE_ROUNDS = 30
+#: the share of triangles moved since the last look above which all are looked at anew
+FULL_LOOK = 0.3
+#: rounds in which a zone's points near the skin move with it (guard)
+FOLLOW_ROUNDS = 10
+#: m: how far through its triangle a crossed point is moved (untangle); the layers' full
+#: thickness would strain the tight folds where most crossings are
+MARGIN = 0.001
 
 
 class Layers:
@@ -85,6 +107,9 @@ class Layers:
         self.tree = AABBTree(net.x, tris, owner=f"{net.name} layers")
         self.tri = np.full((n, CANDIDATES), -1, np.int64)
         self.side = np.zeros((n, CANDIDATES))
+        self.forced = np.zeros((n, CANDIDATES))  # the sides that undo crossings (untangle)
+        self.crossed = 0  # the garments' crossing triangle pairs at the step's start
+        self._seen, self._pairs = None, np.zeros((0, 2), np.int64)  # the last look (_look)
         self.age = 0  # steps since the candidates were gathered
 
     def start(self, nrm=None, limb=None) -> None:
@@ -95,24 +120,101 @@ class Layers:
         x = self.net.x
         if nrm is None:
             nrm, limb = np.zeros_like(x), np.full(len(x), -1, np.int64)
+        pairs = self.remember()
         if self.age % REFRESH == 0:
-            self.tree.refit(x)
             CL.gather(x, self.radius, self.tree.tree, self.mesh, self.tri)
+            CL.untangle(x, self.mesh, pairs, self.tri, self.forced)
         self.age += 1
-        CL.sides(x, self.mesh, CL.Body(nrm, limb), self.tri, self.side)
+        CL.sides(x, self.mesh, CL.Body(nrm, limb), self.tri, self.forced, self.side)
+
+    def remember(self) -> np.ndarray:
+        """The garments' crossing triangle pairs (k,2) now, remembered as the ones the guard
+        lets stand."""
+        pairs = self._look()
+        self.before = _keys(pairs, len(self.mesh.tris))
+        self.crossed = len(pairs)
+        return pairs
+
+    def _look(self) -> np.ndarray:
+        """The garments' crossing triangle pairs now (k,2; each once, the smaller triangle
+        first): the triangles with a point moved since the last look are tested anew against
+        the tree (kernels/impact_zones.crossings_of), the pairs of the others kept; all anew
+        when more than FULL_LOOK of them moved. A zone moved by the guard is a few hundred
+        triangles of 18,600: 0.5 ms to look again where a full look takes 20 ms. Either way
+        the pairs come in one order (sorted), so a run resumed from a checkpoint, whose first
+        look is a full one, repeats the zones bit for bit."""
+        x, tris = self.net.x, self.mesh.tris
+        self.tree.refit(x)
+        moved = (np.ones(len(tris), bool) if self._seen is None
+                 else np.any(x != self._seen, axis=1)[tris].any(axis=1))
+        if moved.mean() > FULL_LOOK:
+            pairs = np.unique(np.sort(self.tree.intersections(), axis=1), axis=0)
+        else:
+            keep = self._pairs[~(moved[self._pairs[:, 0]] | moved[self._pairs[:, 1]])]
+            subset = np.flatnonzero(moved)
+            out = np.empty((max(64, len(subset)), 2), np.int64)
+            count = IZ.crossings_of(x, tris, self.tree.tree, subset, out)
+            if count > len(out):
+                out = np.empty((count, 2), np.int64)
+                IZ.crossings_of(x, tris, self.tree.tree, subset, out)
+            pairs = np.unique(np.concatenate([keep, np.sort(out[:count], axis=1)]), axis=0)
+        self._seen, self._pairs = x.copy(), pairs
+        return pairs
+
+    def guard(self, x0, h: float, follow=None) -> None:
+        """At the very end of the step (h, s), from the points x0 (n,3) m at its start: no
+        triangle pair of the garments that did not cross at the start crosses at the end.
+        The crossing triangles' points are gathered into zones (kernels/impact_zones.py),
+        grown until no new crossing is left: in the first FOLLOW_ROUNDS each zone point with
+        a skin point near moves as that skin point moved, ``follow`` (n,3) m (NaN where none:
+        those move with the zone's best rigid fit), as cloth caught between layers is carried
+        by the body; then every zone moves rigidly, which cannot cross what did not cross at
+        the start (at most ZONE_ROUNDS rounds). A zone's points take the velocity of their
+        move over the step."""
+        net = self.net
+        x = net.x
+        label = np.full(len(x), -1, np.int64)
+        self.guarded = 0
+        carried = None if follow is None else ~np.isnan(follow[:, 0])
+        for k in range(ZONE_ROUNDS):
+            pairs = self._look()
+            new = pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
+            self.left = len(new)
+            if not len(new):
+                break
+            IZ.merge(self.mesh.tris, new, label)
+            self.guarded = IZ.move_rigidly(x0, x, net.m, net.fixed, label)
+            if carried is not None and k < FOLLOW_ROUNDS:
+                on = (label >= 0) & carried & ~net.fixed
+                x[on] = x0[on] + follow[on]
+        # a zone's points take its motion's velocity over the step (what the other moves of
+        # the step gave them is undone with the moves: kept, it carried them through again
+        # in the next step, 8 m/s in the runner's settle)
+        moved = label >= 0
+        net.v[moved] = (x[moved] - x0[moved]) / h
 
     def capture(self) -> dict:
         """What the next steps depend on: the candidates and the steps since they were
         found."""
-        return {"layers_tri": self.tri.copy(), "layers_age": np.array([self.age])}
+        return {"layers_tri": self.tri.copy(), "layers_forced": self.forced.copy(),
+                "layers_age": np.array([self.age])}
 
     def restore(self, snap) -> None:
         self.tri[:] = snap["layers_tri"]
+        if "layers_forced" in snap:  # a checkpoint from before the untangling has none
+            self.forced[:] = snap["layers_forced"]
         self.age = int(np.asarray(snap["layers_age"]).ravel()[0])
+        self._seen = None  # the next look is a full one
 
     def project(self, h: float) -> None:
         """At the step's end (h, s): hold the sides found at its start."""
         net = self.net
         w = np.where(net.fixed, 0.0, 1.0 / net.m)
-        CL.project(net.x, net.v, w, self.mesh, self.tri, self.side, self.thickness,
-                   self.step, self.passes, h)
+        CL.project(net.x, net.v, w, self.mesh, self.tri, self.side, self.forced, self.thickness,
+                   MARGIN, self.step, self.passes, h)
+
+
+def _keys(pairs, m: int) -> np.ndarray:
+    """One integer per unordered triangle pair (k,2) of a mesh of m triangles."""
+    a, b = np.minimum(pairs[:, 0], pairs[:, 1]), np.maximum(pairs[:, 0], pairs[:, 1])
+    return a * m + b

@@ -263,7 +263,8 @@ class Garments(SpringNetwork):
         rows, keys = snap.pop("cert", None), snap.pop("cert_keys", None)
         share = snap.pop("cert_share_keys", None)
         self.limit_stats[:] = snap.pop("limit_stats", np.zeros(3))
-        layers = {k: snap.pop(k) for k in ("layers_tri", "layers_age") if k in snap}
+        layers = {k: snap.pop(k) for k in ("layers_tri", "layers_forced", "layers_age")
+                  if k in snap}
         if self.layers is not None and layers:
             self.layers.restore(layers)
         super().restore(snap)
