@@ -87,6 +87,10 @@ class PosedSkin:
         return X + h * V, V
 
 
+#: how often the stretch limit and the layers' guard run again after the guard (see resolve)
+RELIMITS = 1
+
+
 class _Projector:
     """The projection of one cloth against a skin mesh (its triangles; X0 the skin's first
     vertices for the tree; limbs (nb,) int64 each skin vertex's limb, for a garment worn in
@@ -167,7 +171,7 @@ class _Projector:
             follow = np.full_like(v.x, np.nan)
             follow[hit] = h * np.einsum("kj,kjd->kd", bary[hit], V[self.tris[tri[hit]]])
             self.layers.guard(self.x0, h, follow)
-            if self.limiter is not None:
+            for _ in range(RELIMITS if self.limiter is not None else 0):
                 before = v.v.copy()
                 self.limiter.limit_strain(h, Planes(near, nrm, o))
                 self.dv += v.v - before

@@ -148,7 +148,15 @@ class Layers:
         moved = (np.ones(len(tris), bool) if self._seen is None
                  else np.any(x != self._seen, axis=1)[tris].any(axis=1))
         if moved.mean() > FULL_LOOK:
-            pairs = np.unique(np.sort(self.tree.intersections(), axis=1), axis=0)
+            width = 16  # crossing partners per triangle written; more: looked at again wider
+            while True:
+                out, count = np.empty((len(tris), width), np.int64), np.empty(len(tris), np.int64)
+                IZ.crossings_all(x, tris, self.tree.tree, out, count)
+                if count.max(initial=0) <= width:
+                    break
+                width = int(count.max())
+            on = np.arange(width) < count[:, None]
+            pairs = np.unique(np.column_stack([np.nonzero(on)[0], out[on]]), axis=0)
         else:
             keep = self._pairs[~(moved[self._pairs[:, 0]] | moved[self._pairs[:, 1]])]
             subset = np.flatnonzero(moved)
