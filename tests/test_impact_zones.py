@@ -72,7 +72,7 @@ def layered():
 def test_a_look_at_what_moved_finds_what_a_full_look_finds(layered):
     """The guard looks again only at the triangles with a moved point (Layers._look): 60
     points kicked 2 cm, under FULL_LOOK of the triangles, give the same crossing pairs as a
-    full look."""
+    full look, whether it finds the moved points itself or is told them."""
     from interplay.systems.garment_layers import FULL_LOOK
     net, L = layered, layered.layers
     x0 = net.x.copy()
@@ -83,8 +83,13 @@ def test_a_look_at_what_moved_finds_what_a_full_look_finds(layered):
     assert np.isin(net.triangles, pick).any(axis=1).mean() < FULL_LOOK
     full = {tuple(p) for p in np.sort(AABBTree(net.x, net.triangles).intersections(), axis=1)}
     looked = {tuple(p) for p in L._look()}
+    # told which points moved (as the guard's rounds tell it their zones' points)
+    net.x[pick] += rng.normal(scale=0.02, size=(60, 3))
+    again = {tuple(p) for p in np.sort(AABBTree(net.x, net.triangles).intersections(), axis=1)}
+    told = {tuple(p) for p in L._look(pick)}
     net.x[:] = x0
     assert looked == full and len(full - start) > 0
+    assert told == again and again != full
 
 
 @pytest.mark.parametrize("follow", [False, True])

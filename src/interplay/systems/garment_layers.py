@@ -110,6 +110,9 @@ class Layers:
         self.forced = np.zeros((n, CANDIDATES))  # the sides that undo crossings (untangle)
         self.crossed = 0  # the garments' crossing triangle pairs at the step's start
         self._seen, self._pairs = None, np.zeros((0, 2), np.int64)  # the last look (_look)
+        m = len(tris)  # each point's triangles, as rows of a sparse matrix
+        self._touching = coo_matrix((np.ones(3 * m), (tris.ravel(), np.repeat(np.arange(m), 3))),
+                                    shape=(n, m)).tocsr()
         self.age = 0  # steps since the candidates were gathered
 
     def start(self, nrm=None, limb=None) -> None:
@@ -135,18 +138,24 @@ class Layers:
         self.crossed = len(pairs)
         return pairs
 
-    def _look(self) -> np.ndarray:
+    def _look(self, changed=None) -> np.ndarray:
         """The garments' crossing triangle pairs now (k,2; each once, the smaller triangle
         first): the triangles with a point moved since the last look are tested anew against
         the tree (kernels/impact_zones.crossings_of), the pairs of the others kept; all anew
         when more than FULL_LOOK of them moved. A zone moved by the guard is a few hundred
         triangles of 18,600: 0.5 ms to look again where a full look takes 20 ms. Either way
         the pairs come in one order (sorted), so a run resumed from a checkpoint, whose first
-        look is a full one, repeats the zones bit for bit."""
+        look is a full one, repeats the zones bit for bit. changed: the points that can have
+        moved since the last look (None: any; the guard's rounds name their zones' points)."""
         x, tris = self.net.x, self.mesh.tris
         self.tree.refit(x)
-        moved = (np.ones(len(tris), bool) if self._seen is None
-                 else np.any(x != self._seen, axis=1)[tris].any(axis=1))
+        if self._seen is None:
+            moved = np.ones(len(tris), bool)
+        elif changed is None:
+            moved = np.any(x != self._seen, axis=1)[tris].any(axis=1)
+        else:
+            moved = np.zeros(len(tris), bool)
+            moved[self._touching[changed].indices] = True
         if moved.mean() > FULL_LOOK:
             width = 16  # crossing partners per triangle written; more: looked at again wider
             while True:
@@ -184,17 +193,21 @@ class Layers:
         label = np.full(len(x), -1, np.int64)
         self.guarded = 0
         carried = None if follow is None else ~np.isnan(follow[:, 0])
+        changed = None  # the points the last round moved (None: look at all)
         for k in range(ZONE_ROUNDS):
-            pairs = self._look()
+            pairs = self._look(changed)
             new = pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
             self.left = len(new)
             if not len(new):
                 break
             IZ.merge(self.mesh.tris, new, label)
+            zone = np.flatnonzero(label >= 0)
+            was = x[zone]
             self.guarded = IZ.move_rigidly(x0, x, net.m, net.fixed, label)
             if carried is not None and k < FOLLOW_ROUNDS:
-                on = (label >= 0) & carried & ~net.fixed
+                on = zone[carried[zone] & ~net.fixed[zone]]
                 x[on] = x0[on] + follow[on]
+            changed = zone[np.any(x[zone] != was, axis=1)]
         # a zone's points take its motion's velocity over the step (what the other moves of
         # the step gave them is undone with the moves: kept, it carried them through again
         # in the next step, 8 m/s in the runner's settle)
