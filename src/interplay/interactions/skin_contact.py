@@ -94,9 +94,11 @@ RELIMITS = 1
 class _Projector:
     """The projection of one cloth against a skin mesh (its triangles; X0 the skin's first
     vertices for the tree; limbs (nb,) int64 each skin vertex's limb, for a garment worn in
-    layers), reused by SkinContact and by dressing."""
+    layers; carry: the layers' zones move with the skin first), reused by SkinContact and by
+    dressing."""
 
-    def __init__(self, cloth, tris, params: SkinContactParams, X0, limbs=None):
+    def __init__(self, cloth, tris, params: SkinContactParams, X0, limbs=None,
+                 carry: bool = True):
         self.view = cloth.contact_view()
         self.p = params
         self.tris = np.ascontiguousarray(tris, np.int64)
@@ -117,6 +119,10 @@ class _Projector:
         self.limbs = (np.full(len(X0), -1, np.int64) if limbs is None
                       else np.asarray(limbs, np.int64))
         self.limb = np.full(n, -1, np.int64)  # each point's nearest skin point's limb
+        # the layers' zones carried by the skin under them first (Layers.guard); not while
+        # dressing: the skin then swings from the A-pose (arms 40 deg), and carried by it the
+        # runner's tee stretched 45% at the shoulder (7.6% with rigid zones; docs/clothing.md)
+        self.carry = carry
         self.approach = 0.0  # m: the deepest a point was found inside the skin
         self.count = 0
 
@@ -167,9 +173,11 @@ class _Projector:
             # moves stretch the springs at their rims; the limit then shortens them and the
             # guard looks again (once: the runner's tee at 95% largest strain without, 32%
             # with; docs/clothing.md)
-            hit = tri >= 0
-            follow = np.full_like(v.x, np.nan)
-            follow[hit] = h * np.einsum("kj,kjd->kd", bary[hit], V[self.tris[tri[hit]]])
+            follow = None
+            if self.carry:
+                hit = tri >= 0
+                follow = np.full_like(v.x, np.nan)
+                follow[hit] = h * np.einsum("kj,kjd->kd", bary[hit], V[self.tris[tri[hit]]])
             self.layers.guard(self.x0, h, follow)
             for _ in range(RELIMITS if self.limiter is not None else 0):
                 before = v.v.copy()

@@ -309,7 +309,7 @@ def dress(net: Garments, surface, seg_pos, seg_rot, seconds: float = 0.8,
     h = net.dt if h is None else h
     contact = SkinContactParams() if contact is None else contact
     proj = _Projector(net, surface.triangles, contact, surface.vertices0,
-                      surface.vertex_limbs())
+                      surface.vertex_limbs(), carry=False)
     alpha = net.alpha
     net.alpha = alpha + damping
     steps_move = max(1, int(round(seconds / h))) if seconds > 0 else 1
