@@ -27,9 +27,10 @@ made afresh every step by the cloth's own solve. Two things make it zero:
   crotch are gone within the first steps of the dressing).
 - **The guard** (``guard``, last in the step, kernels/impact_zones.py): no triangle pair that
   did not cross at the step's start crosses at its end; the points of those that do move as
-  zones, first with the skin under them, then rigidly (Provot 1997; Bridson, Fedkiw &
-  Anderson 2002), which cannot cross. The zones' rims stretch: the stretch limit runs again
-  after the guard, and the guard once more (interactions/skin_contact._Projector.resolve).
+  zones, first with the skin under them (in the run; not in the dressing), then rigidly
+  (Provot 1997; Bridson, Fedkiw & Anderson 2002), which cannot cross. The zones' rims
+  stretch: the stretch limit runs again after the guard, and the guard once more
+  (interactions/skin_contact._Projector.resolve).
 """
 from __future__ import annotations
 
