@@ -212,10 +212,9 @@ def untangle(x, mesh, pairs, tri, forced):
     has a corner within two edges of it (which ``gather`` leaves out: 98% of the runner's
     crossings were such tight folds). A corner of a crossed triangle keeps no remembered
     side of another crossed triangle (IGNORE): the side it is on there is the crossed one.
-    ``forced`` is cleared first; it returns the number of ends given a side."""
+    ``forced`` is cleared first."""
     forced[:] = 0.0
     K = tri.shape[1]
-    count = 0
     for j in range(pairs.shape[0]):
         for o in range(2):
             ea, eb = pairs[j, o], pairs[j, 1 - o]
@@ -246,7 +245,6 @@ def untangle(x, mesh, pairs, tri, forced):
                     continue
                 tri[end, slot] = eb
                 forced[end, slot] = 1.0 if other > 0.0 else -1.0
-                count += 1
     # the side a point is on of a crossed triangle is no guide near the crossing: a corner
     # of a crossed triangle holds no other side of one
     crossed = np.zeros(mesh.tris.shape[0], np.bool_)
@@ -261,4 +259,3 @@ def untangle(x, mesh, pairs, tri, forced):
             for k in range(K):
                 if tri[i, k] >= 0 and forced[i, k] == 0.0 and crossed[tri[i, k]]:
                     forced[i, k] = IGNORE
-    return count

@@ -109,7 +109,7 @@ class Layers:
         self.tri = np.full((n, CANDIDATES), -1, np.int64)
         self.side = np.zeros((n, CANDIDATES))
         self.forced = np.zeros((n, CANDIDATES))  # the sides that undo crossings (untangle)
-        self.crossed = 0  # the garments' crossing triangle pairs at the step's start
+        self.before = np.zeros(0, np.int64)  # the crossing pairs let stand (remember, _keys)
         self._seen, self._pairs = None, np.zeros((0, 2), np.int64)  # the last look (_look)
         m = len(tris)  # each point's triangles, as rows of a sparse matrix
         self._touching = coo_matrix((np.ones(3 * m), (tris.ravel(), np.repeat(np.arange(m), 3))),
@@ -136,7 +136,6 @@ class Layers:
         lets stand."""
         pairs = self._look()
         self.before = _keys(pairs, len(self.mesh.tris))
-        self.crossed = len(pairs)
         return pairs
 
     def _look(self, changed=None) -> np.ndarray:
@@ -193,19 +192,17 @@ class Layers:
         net = self.net
         x = net.x
         label = np.full(len(x), -1, np.int64)
-        self.guarded = 0
         carried = None if follow is None else ~np.isnan(follow[:, 0])
         changed = None  # the points the last round moved (None: look at all)
         for k in range(ZONE_ROUNDS):
             pairs = self._look(changed)
             new = pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
-            self.left = len(new)
             if not len(new):
                 break
             IZ.merge(self.mesh.tris, new, label)
             zone = np.flatnonzero(label >= 0)
             was = x[zone]
-            self.guarded = IZ.move_rigidly(x0, x, net.m, net.fixed, label)
+            IZ.move_rigidly(x0, x, net.m, net.fixed, label)
             if carried is not None and k < FOLLOW_ROUNDS:
                 on = zone[carried[zone] & ~net.fixed[zone]]
                 x[on] = x0[on] + follow[on]
