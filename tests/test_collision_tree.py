@@ -241,3 +241,36 @@ def test_serial_and_parallel_refits_fit_the_same_boxes():
     K.refit(a.tree, a.elements, x, x1, 0.01)
     K.refit_serial(b.tree, b.elements, x, x1, 0.01)
     assert np.array_equal(a.lo, b.lo) and np.array_equal(a.hi, b.hi)
+
+
+def test_a_hint_changes_nothing_but_the_search():
+    # any hint, right, wrong, out of reach or none, gives the same nearest triangle bit for
+    # bit: the hint only bounds the descent (kernels/aabb_tree.nearest_triangles)
+    rng = np.random.default_rng(6)
+    x, t = random_soup(rng, 400)
+    pts = rng.uniform(-1.1, 1.1, (2000, 3))
+    tree = AABBTree(x, t)
+    tri, d, bary = tree.nearest(pts, 0.15)
+    moved = pts + rng.normal(0, 0.01, pts.shape)
+    want = tree.nearest(moved, 0.15)
+    for hint in (tri, rng.integers(-1, len(t), len(pts)), np.full(len(pts), -1)):
+        got = tree.nearest(moved, 0.15, hint=hint)
+        for a, b in zip(got, want):
+            assert np.array_equal(a, b)
+    with pytest.raises(ParameterError, match="hint"):
+        tree.nearest(pts, 0.15, hint=np.full(len(pts), len(t)))
+
+
+@pytest.mark.parametrize("m", [500, 3000])
+def test_refitting_the_moved_elements_alone_equals_a_full_refit(m):
+    rng = np.random.default_rng(7)
+    x, t = random_soup(rng, m)
+    tree, full = AABBTree(x, t, pad=0.01), AABBTree(x, t, pad=0.01)
+    for _ in range(5):
+        some = rng.choice(m, m // 20, replace=False)
+        x = x.copy()
+        x[t[some].ravel()] += rng.normal(0, 0.1, (3 * len(some), 3))
+        moved = np.flatnonzero(np.isin(t, t[some]).any(axis=1))  # sharing a moved vertex
+        tree.refit_some(x, moved)
+        full.refit(x)
+        assert np.array_equal(tree.lo, full.lo) and np.array_equal(tree.hi, full.hi)

@@ -56,6 +56,13 @@ class AABBTree:
         self.tree = K.Tree(self.lo, self.hi, self.left, self.right, self.prim)
         self.x = x
         self.refit(x)
+        # each node's parent and each element's leaf, for refitting a few elements
+        self.parent = np.full(nn, -1, np.int64)
+        inner = np.flatnonzero(self.prim < 0)
+        self.parent[self.left[inner]] = inner
+        self.parent[self.right[inner]] = inner
+        self.leaf = np.empty(len(e), np.int64)
+        self.leaf[self.prim[self.prim >= 0]] = np.flatnonzero(self.prim >= 0)
         # body-frame boxes, kept so a rigid object's tree is transformed, never rebuilt
         self.lo0, self.hi0 = self.lo.copy(), self.hi.copy()
         self.body_x = x.copy()
@@ -67,6 +74,14 @@ class AABBTree:
         fit = K.refit if len(self.elements) >= K.PARALLEL_LEAVES else K.refit_serial
         fit(self.tree, self.elements, self.x, x1, self.pad)
 
+    def refit_some(self, x, elements) -> None:
+        """Refit the boxes of the elements (k,) int alone to vertices x, the others' vertices
+        unmoved since the last refit, which was at one position (no x_end)."""
+        some = np.ascontiguousarray(elements, np.int64)
+        check_points(self.owner, x[self.elements[some].ravel()])
+        self.x = x
+        K.refit_some(self.tree, self.elements, x, self.pad, self.parent, self.leaf, some)
+
     def transform(self, R, t, R_end=None, t_end=None):
         """Rigid motion: world boxes from the body-frame boxes at pose (R, t) (and the pose at
         the end of the step); ``self.x`` becomes the world vertices at (R, t)."""
@@ -77,16 +92,23 @@ class AABBTree:
         K.transform_boxes(self.lo0, self.hi0, R, t, R1, t1, 0.0, self.lo, self.hi)
         self.x = self.body_x @ R.T + t
 
-    def nearest(self, points, radius: float, skip_incident: bool = False):
+    def nearest(self, points, radius: float, skip_incident: bool = False, hint=None):
         """For each point (n,3): nearest triangle within radius (m) of it (-1 if none), the
-        distance (m) and the barycentric weights of the closest point."""
+        distance (m) and the barycentric weights of the closest point. hint (n,) int: each
+        point's answer at the last query (or -1), to search from: the same answer, faster when
+        the points moved little."""
         if self.elements.shape[1] != 3:
             raise ParameterError(f"{self.owner}: nearest-triangle queries need triangles")
         p = check_points(self.owner, points, "query points")
         n = len(p)
         tri, d, bary = np.empty(n, np.int64), np.empty(n), np.empty((n, 3))
+        hint = (np.full(n, -1, np.int64) if hint is None
+                else np.ascontiguousarray(hint, np.int64))
+        if hint.shape != (n,) or hint.max(initial=-1) >= len(self.elements):
+            raise ParameterError(f"{self.owner}: a nearest-triangle hint must be one triangle "
+                                 f"index (or -1) per query point, below {len(self.elements)}")
         K.nearest_triangles(p, float(radius), self.tree, self.elements, self.x, skip_incident,
-                            tri, d, bary)
+                            hint, tri, d, bary)
         return tri, d, bary
 
     def overlapping(self, other: "AABBTree | None" = None) -> np.ndarray:

@@ -119,6 +119,7 @@ class _Projector:
         self.limbs = (np.full(len(X0), -1, np.int64) if limbs is None
                       else np.asarray(limbs, np.int64))
         self.limb = np.full(n, -1, np.int64)  # each point's nearest skin point's limb
+        self.near = np.full(n, -1, np.int64)  # each point's nearest skin triangle, last step
         # the layers' zones carried by the skin under them first (Layers.guard); not while
         # dressing: the skin then swings from the A-pose (arms 40 deg), and carried by it the
         # runner's tee stretched 45% at the shoulder (7.6% with rigid zones; docs/clothing.md)
@@ -142,7 +143,8 @@ class _Projector:
             # being pushed into the skin (systems/garment_layers.py)
             self.layers.project(h)
         self.tree.refit(X)
-        tri, d, bary = self.tree.nearest(v.x, self.p.thickness + self.p.reach)
+        tri, d, bary = self.tree.nearest(v.x, self.p.thickness + self.p.reach, hint=self.near)
+        self.near = tri
         vertex_normals(X, self.tris, self.vn)
         signed_distance(v.x, tri, bary, d, X, self.tris, self.across, self.vn, self.s, self.n)
         found = self.s[tri >= 0]

@@ -147,6 +147,26 @@ def refit_serial(tree, elems, x0, x1, pad):
 
 
 @njit(cache=True)
+def refit_some(tree, elems, x, pad, parent, leaf, some):
+    """``refit`` of the elements ``some`` alone, at x (m), for a tree whose other elements
+    have not moved since it was last fitted at one position (x0 = x1): each one's leaf, then
+    its ancestors up to the root (parent (nodes,): -1 at the root; leaf (m,): each element's
+    node). The boxes are the ones a full refit gives, bit for bit; a guard's zone of a few
+    hundred of the runner's 18,600 garment triangles refits in a fraction of the full 0.5 ms."""
+    lo, hi, left, right, _ = tree
+    for s in range(some.shape[0]):
+        node = leaf[some[s]]
+        _fit_leaf(tree, elems, x, x, pad, node)
+        node = parent[node]
+        while node >= 0:
+            ln, rn = left[node], right[node]
+            for r in range(3):
+                lo[node, r] = min(lo[ln, r], lo[rn, r])
+                hi[node, r] = max(hi[ln, r], hi[rn, r])
+            node = parent[node]
+
+
+@njit(cache=True)
 def transform_boxes(lo0, hi0, R0, t0, R1, t1, pad, lo, hi):
     """World boxes of a rigid body's body-frame boxes (lo0, hi0) without rebuilding or refitting:
     each box is rotated (centre R c + t, half-extent |R| e) at the step's start pose (R0, t0)
@@ -182,13 +202,20 @@ def _box_dist2(p, lo, hi, node):
 
 
 @njit(cache=True, inline="always")
-def _nearest_one(p, i, radius, tree, tris, x, skip_incident, st):
+def _nearest_one(p, i, radius, tree, tris, x, skip_incident, hint, st):
     """Nearest triangle to point p (index i) within radius: (triangle or -1, squared distance,
-    barycentric weights). st: a scratch stack."""
+    barycentric weights). hint: a triangle likely nearest (-1: none), whose distance bounds
+    the search from the start. st: a scratch stack."""
     lo, hi, left, right, prim = tree
     best = radius * radius
     bt = -1
     b0, b1, b2 = 0.0, 0.0, 0.0
+    if hint >= 0 and not (skip_incident and (tris[hint, 0] == i or tris[hint, 1] == i
+                                             or tris[hint, 2] == i)):
+        u, v, w, d2 = closest_on_triangle(p, x[tris[hint, 0]], x[tris[hint, 1]],
+                                          x[tris[hint, 2]])
+        if d2 <= best:
+            best, bt, b0, b1, b2 = d2, hint, u, v, w
     st[0] = 0
     top = 1
     while top > 0:
@@ -212,18 +239,23 @@ def _nearest_one(p, i, radius, tree, tris, x, skip_incident, st):
 
 
 @njit(cache=True, parallel=True)
-def nearest_triangles(pts, radius, tree, tris, x, skip_incident, out_tri, out_d, out_bary):
+def nearest_triangles(pts, radius, tree, tris, x, skip_incident, hint, out_tri, out_d,
+                      out_bary):
     """For each point, the nearest triangle within radius (m) of it: index (-1 if none),
     distance (m) and barycentric weights of the closest point. skip_incident: ignore triangles
-    having the point (same index) as a vertex (a network against itself). Race-free: each
-    point writes only its own row."""
+    having the point (same index) as a vertex (a network against itself). hint (n,): each
+    point's nearest triangle at the last query (-1: none). The answer is the same with or
+    without it (the triangle found last in the tree's order among the nearest, the hint's
+    own leaf included), but its distance prunes the descent from the start: the runner's
+    12,470 garment points against 47,292 skin triangles, 35 mm: 16 against 9 ms. Race-free:
+    each point writes only its own row."""
     n = pts.shape[0]
     chunk = 256  # points per task, sharing one scratch stack (no allocation per point)
     for c in prange((n + chunk - 1) // chunk):
         st = np.empty(STACK, np.int64)
         for i in range(c * chunk, min(n, (c + 1) * chunk)):
             bt, d2, b0, b1, b2 = _nearest_one(pts[i], i, radius, tree, tris, x,
-                                              skip_incident, st)
+                                              skip_incident, hint[i], st)
             out_tri[i] = bt
             out_d[i] = np.sqrt(d2) if bt >= 0 else np.inf
             out_bary[i, 0], out_bary[i, 1], out_bary[i, 2] = b0, b1, b2

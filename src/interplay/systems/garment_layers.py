@@ -149,7 +149,6 @@ class Layers:
         look is a full one, repeats the zones bit for bit. changed: the points that can have
         moved since the last look (None: any; the guard's rounds name their zones' points)."""
         x, tris = self.net.x, self.mesh.tris
-        self.tree.refit(x)
         if self._seen is None:
             moved = np.ones(len(tris), bool)
         elif changed is None:
@@ -157,6 +156,10 @@ class Layers:
         else:
             moved = np.zeros(len(tris), bool)
             moved[self._touching[changed].indices] = True
+        if changed is None:
+            self.tree.refit(x)
+        else:
+            self.tree.refit_some(x, np.flatnonzero(moved))
         if moved.mean() > FULL_LOOK:
             width = 16  # crossing partners per triangle written; more: looked at again wider
             while True:

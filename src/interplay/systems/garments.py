@@ -85,6 +85,7 @@ class Garments(SpringNetwork):
         self._skin = None
         self.certificates: list = []
         self._own = None
+        self._near = None  # the certificate's nearest skin triangles, last frame (a hint)
         # systems/garment_layers.Layers: the garments held apart from themselves and each
         # other in the skin contact's projection (None: not)
         self.layers = None
@@ -200,7 +201,8 @@ class Garments(SpringNetwork):
         else:
             self._own.refit(self.x)
         crossing = len(self._body_tree.intersections(self._own))
-        tri, d, bary = self._body_tree.nearest(self.x, 0.05)
+        tri, d, bary = self._body_tree.nearest(self.x, 0.05, hint=self._near)
+        self._near = tri
         s, n = np.full(len(self.x), np.inf), np.zeros_like(self.x)
         vn = np.zeros_like(X)
         vertex_normals(X, skin.tris, vn)
