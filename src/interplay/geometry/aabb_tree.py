@@ -123,17 +123,39 @@ class AABBTree:
             out = np.empty((n, 2), np.int64)
 
     def intersections(self, other: "AABBTree | None" = None) -> np.ndarray:
-        """(k,2) pairs of triangles that interpenetrate (self-intersections when other is None,
-        skipping triangles that share a vertex)."""
-        o = self if other is None else other
+        """(k,2) pairs of triangles that interpenetrate: of this mesh and another, or of this
+        mesh with itself (``crossings``) when other is None."""
+        if other is None:
+            return self.crossings()
         pairs = self.overlapping(other)
-        if other is None and len(pairs):
-            e = self.elements
-            share = (e[pairs[:, 0], :, None] == e[pairs[:, 1], None, :]).any(axis=(1, 2))
-            pairs = pairs[~share]
         hit = np.zeros(len(pairs), np.bool_)
-        intersecting_pairs(self.x, self.elements, o.x, o.elements, pairs, hit)
+        intersecting_pairs(self.x, self.elements, other.x, other.elements, pairs, hit)
         return pairs[hit]
+
+    def crossings(self, subset=None) -> np.ndarray:
+        """The mesh's self-intersections (triangles sharing a corner apart): (k,2) pairs,
+        each once, the smaller triangle first, sorted. subset (k,) int: only the pairs with a
+        triangle in it (what moved since the pairs were last found). Each triangle against
+        the tree; all of them in parallel (7 ms for the runner's 18,600 garment triangles,
+        21 ms by the boxes' overlap and a filter)."""
+        x, tris = self.x, self.elements
+        if subset is None:
+            width = 16  # partners per triangle written; more: looked at again wider
+            while True:
+                out, count = np.empty((len(tris), width), np.int64), np.empty(len(tris), np.int64)
+                K.crossings_all(x, tris, self.tree, out, count)
+                if count.max(initial=0) <= width:
+                    break
+                width = int(count.max())
+            on = np.arange(width) < count[:, None]
+            return np.unique(np.column_stack([np.nonzero(on)[0], out[on]]), axis=0)
+        subset = np.ascontiguousarray(subset, np.int64)
+        out = np.empty((max(64, len(subset)), 2), np.int64)
+        count = K.crossings_of(x, tris, self.tree, subset, out)
+        if count > len(out):
+            out = np.empty((count, 2), np.int64)
+            K.crossings_of(x, tris, self.tree, subset, out)
+        return np.unique(np.sort(out[:count], axis=1), axis=0).reshape(-1, 2)
 
     def edge_contacts(self, other: "AABBTree", reach: float):
         """Segment pairs of two segment trees closer than reach (m): (pairs (k,2), closest-point

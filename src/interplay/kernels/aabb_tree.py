@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from .sorting import stable_argsort
-from .trimesh_contact import closest_on_triangle
+from .trimesh_contact import closest_on_triangle, triangles_intersect
 
 
 class Tree(NamedTuple):
@@ -360,3 +360,78 @@ def deepest_on_segments(xm, tris, start, faces, x, segs, out_t, out_s):
         t = 0.5 * (lo + hi)
         out_t[i] = t
         out_s[i] = np.max(alpha + beta * t)
+
+
+@njit(cache=True, inline="always")
+def _crossings_one(x, tris, tree, e, later, st, out, row, cap):
+    """The triangles crossing triangle e (those after it only, if ``later``), written to
+    out[row, :cap]; returns their count (may exceed cap)."""
+    lo, hi, left, right, prim = tree
+    a, b, c = tris[e, 0], tris[e, 1], tris[e, 2]
+    blo0 = min(x[a, 0], x[b, 0], x[c, 0])
+    blo1 = min(x[a, 1], x[b, 1], x[c, 1])
+    blo2 = min(x[a, 2], x[b, 2], x[c, 2])
+    bhi0 = max(x[a, 0], x[b, 0], x[c, 0])
+    bhi1 = max(x[a, 1], x[b, 1], x[c, 1])
+    bhi2 = max(x[a, 2], x[b, 2], x[c, 2])
+    n = 0
+    st[0] = 0
+    top = 1
+    while top > 0:
+        top -= 1
+        node = st[top]
+        if (lo[node, 0] > bhi0 or blo0 > hi[node, 0] or lo[node, 1] > bhi1
+                or blo1 > hi[node, 1] or lo[node, 2] > bhi2 or blo2 > hi[node, 2]):
+            continue
+        f = prim[node]
+        if f < 0:
+            st[top] = left[node]
+            st[top + 1] = right[node]
+            top += 2
+            continue
+        if later and f <= e:
+            continue
+        p, q, w = tris[f, 0], tris[f, 1], tris[f, 2]
+        if p == a or p == b or p == c or q == a or q == b or q == c or w == a or w == b \
+                or w == c:
+            continue
+        if triangles_intersect(x[a], x[b], x[c], x[p], x[q], x[w]):
+            if n < cap:
+                out[row, n] = f
+            n += 1
+    return n
+
+
+@njit(cache=True)
+def crossings_of(x, tris, tree, subset, out):
+    """The triangle pairs (i, j) that cross, for each triangle i of ``subset`` against every
+    triangle j of the mesh sharing no corner with it (the tree refit to x): what moved since
+    the last look is all that can have come to cross (systems/garment_layers.py). Writes up to len(out) pairs (k,2) and
+    returns the count (call again with a larger out when it exceeds it); a pair with both
+    triangles in the subset comes twice."""
+    st = np.empty(STACK, np.int64)
+    row = np.empty((1, 64), np.int64)
+    cap = out.shape[0]
+    n = 0
+    for s in range(subset.shape[0]):
+        e = subset[s]
+        k = _crossings_one(x, tris, tree, e, False, st, row, 0, row.shape[1])
+        if k > row.shape[1]:  # a tangle: a wider row, and that triangle again
+            row = np.empty((1, k), np.int64)
+            k = _crossings_one(x, tris, tree, e, False, st, row, 0, k)
+        for j in range(k):
+            if n < cap:
+                out[n, 0], out[n, 1] = e, row[0, j]
+            n += 1
+    return n
+
+
+@njit(cache=True, parallel=True)
+def crossings_all(x, tris, tree, out, count):
+    """Every crossing triangle pair of the mesh (no shared corner), each once: for each
+    triangle e the crossing triangles after it in out[e, :] (count[e] of them; more than
+    out's width are counted, not written). Parallel over the triangles: the guard's full
+    look, 2x the serial one when the other core is free."""
+    for e in prange(tris.shape[0]):
+        st = np.empty(STACK, np.int64)
+        count[e] = _crossings_one(x, tris, tree, e, True, st, out, e, out.shape[1])

@@ -141,10 +141,10 @@ class Layers:
     def _look(self, changed=None) -> np.ndarray:
         """The garments' crossing triangle pairs now (k,2; each once, the smaller triangle
         first): the triangles with a point moved since the last look are tested anew against
-        the tree (kernels/impact_zones.crossings_of), the pairs of the others kept; all anew
-        when more than FULL_LOOK of them moved (kernels/impact_zones.crossings_all, in
-        parallel). A zone moved by the guard is a few hundred triangles of 18,600: 0.3 ms to
-        look again where a full look takes 7 ms (21 ms by the trees' overlap). Either way
+        the tree (geometry/aabb_tree.AABBTree.crossings), the pairs of the others kept; all
+        anew when more than FULL_LOOK of them moved (in parallel). A zone moved by the guard
+        is a few hundred triangles of 18,600: 0.3 ms to look again where a full look takes
+        7 ms. Either way
         the pairs come in one order (sorted), so a run resumed from a checkpoint, whose first
         look is a full one, repeats the zones bit for bit. changed: the points that can have
         moved since the last look (None: any; the guard's rounds name their zones' points)."""
@@ -161,24 +161,11 @@ class Layers:
         else:
             self.tree.refit_some(x, np.flatnonzero(moved))
         if moved.mean() > FULL_LOOK:
-            width = 16  # crossing partners per triangle written; more: looked at again wider
-            while True:
-                out, count = np.empty((len(tris), width), np.int64), np.empty(len(tris), np.int64)
-                IZ.crossings_all(x, tris, self.tree.tree, out, count)
-                if count.max(initial=0) <= width:
-                    break
-                width = int(count.max())
-            on = np.arange(width) < count[:, None]
-            pairs = np.unique(np.column_stack([np.nonzero(on)[0], out[on]]), axis=0)
+            pairs = self.tree.crossings()
         else:
             keep = self._pairs[~(moved[self._pairs[:, 0]] | moved[self._pairs[:, 1]])]
-            subset = np.flatnonzero(moved)
-            out = np.empty((max(64, len(subset)), 2), np.int64)
-            count = IZ.crossings_of(x, tris, self.tree.tree, subset, out)
-            if count > len(out):
-                out = np.empty((count, 2), np.int64)
-                IZ.crossings_of(x, tris, self.tree.tree, subset, out)
-            pairs = np.unique(np.concatenate([keep, np.sort(out[:count], axis=1)]), axis=0)
+            pairs = np.unique(np.concatenate([keep, self.tree.crossings(np.flatnonzero(moved))]),
+                              axis=0)
         self._seen, self._pairs = x.copy(), pairs
         return pairs
 
