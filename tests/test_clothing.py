@@ -409,6 +409,26 @@ def _slope_skin(theta):
     return np.asarray(box.vertices) @ R.T, np.asarray(box.faces, np.int64), R
 
 
+def test_a_point_riding_the_skin_is_kept_just_outside_it():
+    """Points that ride the skin (a pinned waistband) are placed by its weights, which where
+    the skin folds carry a few just inside it: the contact moves those out to RIDE_OFF along
+    the normal and leaves the others, pinned or free, where their own rules put them."""
+    from interplay.interactions import skin_contact as SCm
+    from interplay.systems.springmass import Springs
+    X, T, R = _slope_skin(0.0)  # the top face at z = 0.1
+    x = np.array([[0.0, 0.0, 0.0995], [0.1, 0.0, 0.103], [0.2, 0.0, 0.0995]])
+    net = SpringNetwork("band", x.copy(), [1e-3] * 3,
+                        Springs(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0),
+                                np.zeros(0), np.zeros(0, bool)), dt=1e-3, integrator="explicit")
+    net.fixed[:2] = True  # 0: pinned, 0.5 mm inside; 1: pinned, 3 mm out; 2: free, inside
+    proj = _Projector(net, T, SkinContactParams(thickness=0.004, friction=0.0), X)
+    proj.start()
+    proj.resolve(X, np.zeros_like(X), 1e-3)
+    assert net.x[0] == pytest.approx([0.0, 0.0, 0.1 + SCm.RIDE_OFF], abs=1e-12)
+    assert net.x[1] == pytest.approx(x[1], abs=1e-15)  # outside: its place is the skin's
+    assert net.x[2, 2] == pytest.approx(0.104, abs=1e-12)  # free: out to the thickness
+
+
 @pytest.mark.parametrize("theta_deg,mu,sticks", [(20.0, 0.5, True), (35.0, 0.5, False)])
 def test_friction_holds_below_the_cone_and_slides_by_coulomb_above(theta_deg, mu, sticks):
     """A point resting on a slope of the skin under gravity (symplectic Euler steps of 1 ms,

@@ -89,6 +89,8 @@ class PosedSkin:
 
 #: how often the stretch limit and the layers' guard run again after the guard (see resolve)
 RELIMITS = 1
+#: m: the least a point that rides the skin is kept off it (see resolve)
+RIDE_OFF = 0.001
 
 
 class _Projector:
@@ -150,6 +152,13 @@ class _Projector:
         found = self.s[tri >= 0]
         if len(found):
             self.approach = max(self.approach, float(-found.min()))
+        # points that ride the skin (a gripping waistband) are placed by its weights, not
+        # moved by the contact; where the skin folds (her hip flexed, seated on the swing)
+        # the weights carry a few of them just inside it (0.5 mm: all 9 crossings of her skin
+        # at the swing's frame 0): those go out to RIDE_OFF
+        inside = v.points.fixed & (tri >= 0) & (self.s < RIDE_OFF)
+        if inside.any():
+            v.x[inside] += (RIDE_OFF - self.s[inside])[:, None] * self.n[inside]
         self.count = int(project(v.points, self.x0, Skin(X, V, self.tris),
                                  Nearest(tri, bary, self.s, self.n),
                                  Law(self.p.thickness, self.p.friction, h), self.dv))
