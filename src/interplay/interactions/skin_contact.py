@@ -183,7 +183,8 @@ class _Projector:
             # cloth's own, not the skin's push: they stay out of the reaction). The zones it
             # moves stretch the springs at their rims; the limit then shortens them and the
             # guard looks again (once: the runner's tee at 95% largest strain without, 32%
-            # with; docs/clothing.md)
+            # with), its zones rigid from the first round: carried by the skin they stretch
+            # within (the tee's worst 31%, 12% rigid; docs/clothing.md)
             follow = None
             if self.carry:
                 hit = tri >= 0
@@ -194,7 +195,7 @@ class _Projector:
                 before = v.v.copy()
                 self.limiter.limit_strain(h, Planes(near, nrm, o))
                 self.dv += v.v - before
-                self.layers.guard(self.x0, h, follow)
+                self.layers.guard(self.x0, h)
         c = np.zeros(3) if centre is None else np.asarray(centre, float)
         return reaction(v.x, v.masses, self.dv, h, c)
 
