@@ -497,6 +497,11 @@ def test_the_runners_garments_never_cross_or_enter_the_body():
     # nor any garment triangle another (the layers' untangling and guard)
     selfx = [f["self_intersections"] for f in frames]
     assert max(selfx) == 0, selfx
+    # the guard's zones stretch their rims; the second guard's are rigid, so the re-limit's
+    # work stands: the tee's worst spring 11.9% over the run (31% when that guard's zones were
+    # carried by the skin). Not yet the issue's 5%: a bound against losing what was won
+    tee = [f["stretch"]["tee"] for f in frames]
+    assert max(tee) <= 0.15, max(tee)
 
 
 def _layered(surface, layers: bool, seconds: float = 0.25):
