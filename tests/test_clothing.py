@@ -508,8 +508,8 @@ def _layered(surface, layers: bool, seconds: float = 0.25):
     """Sweat pants and a tee cut on the A-pose body with no regard for each other (the tee
     not cut ``over`` the pants: its hem crosses the pants' seat), joined into one network
     (pants first, the tee over them), run for ``seconds`` on the still body with the skin
-    contact and, if ``layers``, the layers held apart; returns (tee-pants crossing pairs at the start, at the end, the
-    deepest point inside the skin (m), the largest tee strain)."""
+    contact and, if ``layers``, the layers held apart; returns (tee-pants crossing pairs at
+    the start, at the end, the deepest point inside the skin (m), the largest tee strain)."""
     from interplay.scenes import runner as RN
     from interplay.systems.garment_layers import Layers
     pants = G.sweatpants(surface, G.Fit(spacing=0.03, ease=0.025, shortest=0.3))

@@ -406,9 +406,9 @@ def _crossings_one(x, tris, tree, e, later, st, out, row, cap):
 def crossings_of(x, tris, tree, subset, out):
     """The triangle pairs (i, j) that cross, for each triangle i of ``subset`` against every
     triangle j of the mesh sharing no corner with it (the tree refit to x): what moved since
-    the last look is all that can have come to cross (systems/garment_layers.py). Writes up to len(out) pairs (k,2) and
-    returns the count (call again with a larger out when it exceeds it); a pair with both
-    triangles in the subset comes twice."""
+    the last look is all that can have come to cross (systems/garment_layers.py). Writes up
+    to len(out) pairs (k,2) and returns the count (call again with a larger out when it
+    exceeds it); a pair with both triangles in the subset comes twice."""
     st = np.empty(STACK, np.int64)
     row = np.empty((1, 64), np.int64)
     cap = out.shape[0]
