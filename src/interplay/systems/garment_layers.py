@@ -203,6 +203,25 @@ class Layers:
         moved = label >= 0
         net.v[moved] = (x[moved] - x0[moved]) / h
 
+    def undo_new_crossings(self, x_safe, v_safe) -> None:
+        """After a move from x_safe (n,3) m (a state with no new crossing, velocities v_safe):
+        the points of every triangle pair that came to cross go back to x_safe, until none
+        is left (at worst every point: x_safe)."""
+        x, v = self.net.x, self.net.v
+        changed = None
+        for _ in range(ZONE_ROUNDS):
+            pairs = self._look(changed)
+            new = pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
+            if not len(new):
+                return
+            back = np.unique(self.mesh.tris[new].ravel())
+            back = back[np.any(x[back] != x_safe[back], axis=1)]
+            if not len(back):
+                break
+            x[back], v[back] = x_safe[back], v_safe[back]
+            changed = back
+        x[:], v[:] = x_safe, v_safe
+
     def capture(self) -> dict:
         """What the next steps depend on: the candidates and the steps since they were
         found."""
