@@ -497,11 +497,12 @@ def test_the_runners_garments_never_cross_or_enter_the_body():
     # nor any garment triangle another (the layers' untangling and guard)
     selfx = [f["self_intersections"] for f in frames]
     assert max(selfx) == 0, selfx
-    # the guard's zones stretch their rims; the second guard's are rigid, so the re-limit's
-    # work stands: the tee's worst spring 11.9% over the run (31% when that guard's zones were
-    # carried by the skin). Not yet the issue's 5%: a bound against losing what was won
+    # the guard's zones stretch their rims; the second guard's are rigid and the last limit is
+    # undone only where it crosses: the tee's worst spring 8.7% over the run (11.9% without
+    # that last limit, 31% when the second guard's zones were carried by the skin). Not yet
+    # the issue's 5%: a bound against losing what was won
     tee = [f["stretch"]["tee"] for f in frames]
-    assert max(tee) <= 0.15, max(tee)
+    assert max(tee) <= 0.11, max(tee)
 
 
 def _layered(surface, layers: bool, seconds: float = 0.25):
