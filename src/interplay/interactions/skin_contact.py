@@ -52,11 +52,15 @@ class SkinContactParams:
     thickness plus what keeps a triangle's middle off a curved limb); friction mu (-), cloth
     on skin; reach (m): how deep inside the skin a point is still found and pushed out (more
     than the cloth and skin close in one step); tether (m): each garment point is kept within
-    it of where the skin's weights carry it (systems.garments.Garments.tether; 0: off)."""
+    it of where the skin's weights carry it (systems.garments.Garments.tether; 0: off);
+    final_limits: how often a garment worn in layers has its stretch limit run last, undone
+    where it crosses (see _Projector.resolve: accuracy against speed, the runner's garments'
+    pass 17% longer for each, docs/clothing.md)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)
     reach: float = param(0.03, "m", gt=0.0, le=0.5)
     tether: float = param(0.03, "m", ge=0.0, le=1.0, doc="0: none")
+    final_limits: int = param(1, "passes", ge=0, le=5, doc="0: fastest")
 
 
 class PosedSkin:
@@ -89,9 +93,6 @@ class PosedSkin:
 
 #: how often the stretch limit and the layers' guard run again after the guard (see resolve)
 RELIMITS = 1
-#: how often the stretch limit runs last, each time with the new crossings it made undone
-#: (see resolve)
-FINAL_LIMITS = 1
 #: m: the least a point that rides the skin is kept off it (see resolve)
 RIDE_OFF = 0.001
 
@@ -203,7 +204,7 @@ class _Projector:
             # the points of the triangles it made cross go back (the runner's tee: median
             # frame 7.0 -> 5.7%, worst 11.9 -> 8.7%, for 17% of the garments' pass; twice,
             # 5.0% and 8.9% for 32%; docs/clothing.md)
-            for _ in range(FINAL_LIMITS if self.limiter is not None else 0):
+            for _ in range(self.p.final_limits if self.limiter is not None else 0):
                 safe_x, safe_v = v.x.copy(), v.v.copy()
                 self.limiter.limit_strain(h, Planes(near, nrm, o))
                 self.layers.undo_new_crossings(safe_x, safe_v)
