@@ -29,8 +29,9 @@ made afresh every step by the cloth's own solve. Two things make it zero:
   did not cross at the step's start crosses at its end; the points of those that do move as
   zones, first with the skin under them (in the run; not in the dressing), then rigidly
   (Provot 1997; Bridson, Fedkiw & Anderson 2002), which cannot cross. The zones' rims
-  stretch: the stretch limit runs again after the guard, and the guard once more
-  (interactions/skin_contact._Projector.resolve).
+  stretch: the stretch limit runs again after the guard, and the guard once more, its zones
+  rigid; then the limit once more, undone where it made a crossing (``undo_new_crossings``;
+  interactions/skin_contact._Projector.resolve).
 """
 from __future__ import annotations
 
@@ -144,10 +145,10 @@ class Layers:
         the tree (geometry/aabb_tree.AABBTree.crossings), the pairs of the others kept; all
         anew when more than FULL_LOOK of them moved (in parallel). A zone moved by the guard
         is a few hundred triangles of 18,600: 0.3 ms to look again where a full look takes
-        7 ms. Either way
-        the pairs come in one order (sorted), so a run resumed from a checkpoint, whose first
-        look is a full one, repeats the zones bit for bit. changed: the points that can have
-        moved since the last look (None: any; the guard's rounds name their zones' points)."""
+        7 ms. Either way the pairs come in one order (sorted), so a run resumed from a
+        checkpoint, whose first look is a full one, repeats the zones bit for bit. changed:
+        the points that can have moved since the last look (None: any; the guard's rounds
+        name their zones' points)."""
         x, tris = self.net.x, self.mesh.tris
         if self._seen is None:
             moved = np.ones(len(tris), bool)
@@ -169,6 +170,12 @@ class Layers:
         self._seen, self._pairs = x.copy(), pairs
         return pairs
 
+    def _new_crossings(self, changed=None) -> np.ndarray:
+        """The crossing pairs now (``_look``; changed: the points moved since it last
+        looked) that were not let stand at the step's start (``remember``)."""
+        pairs = self._look(changed)
+        return pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
+
     def guard(self, x0, h: float, follow=None) -> None:
         """At the very end of the step (h, s), from the points x0 (n,3) m at its start: no
         triangle pair of the garments that did not cross at the start crosses at the end.
@@ -185,8 +192,7 @@ class Layers:
         carried = None if follow is None else ~np.isnan(follow[:, 0])
         changed = None  # the points the last round moved (None: look at all)
         for k in range(ZONE_ROUNDS):
-            pairs = self._look(changed)
-            new = pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
+            new = self._new_crossings(changed)
             if not len(new):
                 break
             IZ.merge(self.mesh.tris, new, label)
@@ -210,8 +216,7 @@ class Layers:
         x, v = self.net.x, self.net.v
         changed = None
         for _ in range(ZONE_ROUNDS):
-            pairs = self._look(changed)
-            new = pairs[~np.isin(_keys(pairs, len(self.mesh.tris)), self.before)]
+            new = self._new_crossings(changed)
             if not len(new):
                 return
             back = np.unique(self.mesh.tris[new].ravel())
