@@ -321,6 +321,38 @@ def test_the_strain_limit_keeps_momentum_and_pinned_points():
         assert np.allclose((net.v - v0)[moved] / 240.0, (net.x - x0)[moved], atol=1e-15)
 
 
+def test_garments_worn_together_are_limited_each_on_its_own():
+    """Two strips joined into one network (as the runner's tee and pants), stretched with
+    jitter: the limit runs each garment's passes on its own, the two in parallel
+    (kernels/strain_limit.limit_strain). They share no point, so each must end bit for bit
+    where it ends limited alone, both within their caps (the one stretched 20% is done in
+    about half the passes of the one stretched 60%: a garment that stops early must not
+    change the other's passes)."""
+    from interplay.geometry.garment import join
+    rng = np.random.default_rng(5)
+    a, b = strip_network(8, limit=0.05), strip_network(12, limit=0.03)
+    a.x[:, 2] *= 1.2
+    b.x[:, 2] *= 1.6
+    for net in (a, b):
+        net.x[~net.fixed] += rng.normal(0.0, 0.001, (int((~net.fixed).sum()), 3))
+        net.v[:] = rng.normal(0.0, 0.5, net.v.shape)
+    gb = b.garment  # renamed: the joined garment's groups are named after its garments
+    gb = G.Garment("other", gb.vertices, gb.triangles, gb.fabric, gb.groups)
+    both = G.network(join("both", a.garment, gb), dt=1.0 / 240.0)
+    both.x[:] = np.r_[a.x, b.x]  # on each other: the limit looks only along springs
+    both.v[:] = np.r_[a.v, b.v]
+    assert len(both.parts) == 2
+    for net in (a, b, both):
+        net.limit_strain(1.0 / 240.0)
+    n = len(a.x)
+    assert np.array_equal(both.x[:n], a.x) and np.array_equal(both.v[:n], a.v)
+    assert np.array_equal(both.x[n:], b.x) and np.array_equal(both.v[n:], b.v)
+    assert structural_strain(a) <= 0.05 + 1e-12
+    assert structural_strain(b) <= 0.03 + 1e-12
+    # a is done in fewer passes than b: its passes stop while b's go on
+    assert a.limit_stats[0] < b.limit_stats[0] == both.limit_stats[0]
+
+
 def test_the_strain_limit_leaves_a_contact_plane_on_its_outer_side():
     """A strip (in the x-z plane) pinned along both side edges, stretched 20% between them,
     its middle column pushed 2 cm out of the plane by a post: the half-space y >= 0.02 m.

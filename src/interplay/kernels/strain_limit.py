@@ -18,6 +18,11 @@ projection's matrix J W J^T is then singular, and its linearised steps overshot 
 of 4 to 100 on a hanging strip (tried; docs/clothing.md). A single spring's projection
 cannot overshoot.
 
+The garments of one network share no point, so each garment's passes run on their own, the
+garments in parallel (a tee and sweat pants: 0.7x the time of one after the other on the
+two cores): the springs, reaches and planes come grouped by garment (``start``: each
+garment's first entry, then the count).
+
 Notation (SI): points x (n,3) m, velocities v (n,3) m/s, inverse masses w (n,) 1/kg (0:
 fixed); Limits: the springs' end points i, j (s,) and caps (s,) m; Planes: points idx (k,),
 unit normals n (k,3), offsets o (k,) m.
@@ -25,7 +30,7 @@ unit normals n (k,3), offsets o (k,) m.
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 #: a spring over its cap is shortened to (1 - UNDERSHOOT) of it: the passes then stop for
 #: good once none is over, instead of creeping towards the cap from above
@@ -134,18 +139,10 @@ def _keep_out(x, w, planes):
 
 
 @njit(cache=True)
-def limit_strain(x, v, w, lim, reach, planes, h, sweeps):
-    """Shorten every spring of ``lim`` longer than its cap, in up to ``sweeps`` Gauss-Seidel
-    passes alternating forward and backward, each after the Reach and followed by the
-    planes, until a full pass finds no spring over its cap and the planes move nothing.
-    Between full passes only the springs within NEAR of their caps at the last full one are
-    visited. The velocities v
-    change by each point's move over the step h (s), as Provot's do, so that x - x_n = h v
-    still holds for the step that ends here. Returns (passes taken, the largest excess over
-    a cap the last pass found: 0 if none)."""
-    ns = lim.i.shape[0]
-    x0 = x.copy()
-    near = np.empty(ns, np.int64)
+def _passes(x, w, lim, a, b, reach, planes, sweeps, near):
+    """The passes over the springs a..b-1 of ``lim`` (one garment), its reach and planes:
+    see ``limit_strain``; near: scratch for the springs' indices (its a..b-1 are used).
+    Returns (passes taken, the largest excess over a cap the last pass found)."""
     m = 0
     worst = 0.0
     taken = 0
@@ -157,13 +154,13 @@ def limit_strain(x, v, w, lim, reach, planes, h, sweeps):
         if full:
             m = 0
             since = 0
-        count = ns if full else m
+        count = b - a if full else m
         for q in range(count):
             t = q if taken % 2 == 0 else count - 1 - q
-            s = t if full else near[t]
+            s = a + t if full else near[a + t]
             e = _correct(x, w, lim, s)
             if full and e > -NEAR:
-                near[m] = s
+                near[a + m] = s
                 m += 1
             worst = max(worst, e)
         moved = _keep_out(x, w, planes)
@@ -173,8 +170,42 @@ def limit_strain(x, v, w, lim, reach, planes, h, sweeps):
             if full:
                 break
             since = REFRESH  # the near springs are done: a full pass to confirm
+    return taken, max(worst, 0.0)
+
+
+@njit(cache=True, parallel=True)
+def limit_strain(x, v, w, lim, lstart, reach, rstart, planes, pstart, h, sweeps):
+    """Shorten every spring of ``lim`` longer than its cap, in up to ``sweeps`` Gauss-Seidel
+    passes alternating forward and backward, each after the Reach and followed by the
+    planes, until a full pass finds no spring over its cap and the planes move nothing.
+    Between full passes only the springs within NEAR of their caps at the last full one are
+    visited. Each garment g (its springs lim[lstart[g]:lstart[g+1]], its reach
+    rstart[g]:rstart[g+1], its planes pstart[g]:pstart[g+1]) on its own, in parallel: they
+    share no point. The velocities v change by each point's move over the step h (s), as
+    Provot's do, so that x - x_n = h v still holds for the step that ends here. Returns
+    (the most passes a garment took, the largest excess over a cap the last passes found:
+    0 if none)."""
+    parts = lstart.shape[0] - 1
+    x0 = x.copy()
+    near = np.empty(lim.i.shape[0], np.int64)
+    taken = np.zeros(parts, np.int64)
+    worst = np.zeros(parts)
+    for g in prange(parts):
+        r0, r1, p0, p1 = rstart[g], rstart[g + 1], pstart[g], pstart[g + 1]
+        taken[g], worst[g] = _passes(
+            x, w, lim, lstart[g], lstart[g + 1],
+            Reach(reach.idx[r0:r1], reach.pin[r0:r1], reach.dist[r0:r1]),
+            Planes(planes.idx[p0:p1], planes.n[p0:p1], planes.o[p0:p1]), sweeps, near)
     for p in range(x.shape[0]):
         if w[p] > 0.0:
             for r in range(3):
                 v[p, r] += (x[p, r] - x0[p, r]) / h
-    return taken, max(worst, 0.0)
+    return taken.max(), worst.max()
+
+
+def starts(part, idx, parts: int) -> tuple[np.ndarray, np.ndarray]:
+    """The order that groups entries on points idx (k,) by their garment part[idx] (part
+    (n,) int64, 0..parts-1; the entries' own order kept within a garment), and each
+    garment's first entry in that order, then k (parts+1,)."""
+    order = np.argsort(part[idx], kind="stable")
+    return order, np.searchsorted(part[idx][order], np.arange(parts + 1))

@@ -74,8 +74,17 @@ class Garments(SpringNetwork):
         for p in (garment.parts or (garment,)):
             limit[self.parts[p.name]] = p.fabric.stretch_limit
         on = (kind == 0) & ~self.band & np.isfinite(limit[self.si])
-        self.limits = SL.Limits(self.si[on], self.sj[on], self.l0[on] * (1.0 + limit[self.si[on]]))
-        self.reach = self._reach(limit)
+        # the limit runs each garment on its own (kernels/strain_limit.py): its springs and
+        # reaches grouped by garment
+        self.part = np.zeros(len(self.x), np.int64)
+        for k, idx in enumerate(self.parts.values()):
+            self.part[idx] = k
+        o, self.limit_start = SL.starts(self.part, self.si[on], len(self.parts))
+        si, sj, cap = self.si[on][o], self.sj[on][o], (self.l0[on] * (1.0 + limit[self.si[on]]))[o]
+        self.limits = SL.Limits(si, sj, cap)
+        reach = self._reach(limit)
+        o, self.reach_start = SL.starts(self.part, reach.idx, len(self.parts))
+        self.reach = SL.Reach(reach.idx[o], reach.pin[o], reach.dist[o])
         # a skin contact runs the limit itself, after its projection (interactions/
         # skin_contact._Projector), so the two agree; otherwise the advance ends with it
         self.limit_by_contact = False
@@ -105,9 +114,12 @@ class Garments(SpringNetwork):
         if not len(self.limits.i):
             return
         w = np.where(self.fixed, 0.0, 1.0 / self.m)
-        passes, left = SL.limit_strain(self.x, self.v, w, self.limits, self.reach,
-                                       SL.no_planes() if planes is None else planes, h,
-                                       LIMIT_SWEEPS)
+        planes = SL.no_planes() if planes is None else planes
+        o, start = SL.starts(self.part, planes.idx, len(self.parts))
+        passes, left = SL.limit_strain(self.x, self.v, w, self.limits, self.limit_start,
+                                       self.reach, self.reach_start,
+                                       SL.Planes(planes.idx[o], planes.n[o], planes.o[o]),
+                                       start, h, LIMIT_SWEEPS)
         st = self.limit_stats
         st[0] = max(st[0], passes)
         st[1] += left > 0.0
