@@ -402,28 +402,16 @@ def _crossings_one(x, tris, tree, e, later, st, out, row, cap):
     return n
 
 
-@njit(cache=True)
-def crossings_of(x, tris, tree, subset, out):
-    """The triangle pairs (i, j) that cross, for each triangle i of ``subset`` against every
-    triangle j of the mesh sharing no corner with it (the tree refit to x): what moved since
-    the last look is all that can have come to cross (systems/garment_layers.py). Writes up
-    to len(out) pairs (k,2) and returns the count (call again with a larger out when it
-    exceeds it); a pair with both triangles in the subset comes twice."""
-    st = np.empty(STACK, np.int64)
-    row = np.empty((1, 64), np.int64)
-    cap = out.shape[0]
-    n = 0
-    for s in range(subset.shape[0]):
-        e = subset[s]
-        k = _crossings_one(x, tris, tree, e, False, st, row, 0, row.shape[1])
-        if k > row.shape[1]:  # a tangle: a wider row, and that triangle again
-            row = np.empty((1, k), np.int64)
-            k = _crossings_one(x, tris, tree, e, False, st, row, 0, k)
-        for j in range(k):
-            if n < cap:
-                out[n, 0], out[n, 1] = e, row[0, j]
-            n += 1
-    return n
+@njit(cache=True, parallel=True)
+def crossings_of(x, tris, tree, subset, out, count):
+    """The triangles crossing each triangle of ``subset`` (any triangle of the mesh sharing
+    no corner with it; the tree refit to x): what moved since the last look is all that can
+    have come to cross (systems/garment_layers.py). For each subset[k] the crossing
+    triangles in out[k, :] (count[k] of them; more than out's width are counted, not
+    written). Parallel over the subset, as ``crossings_all``."""
+    for k in prange(subset.shape[0]):
+        st = np.empty(STACK, np.int64)
+        count[k] = _crossings_one(x, tris, tree, subset[k], False, st, out, k, out.shape[1])
 
 
 @njit(cache=True, parallel=True)

@@ -25,7 +25,7 @@ one may. ``forced`` (n,K): a side untangle chose (+-1), IGNORE, or 0 (none).
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from .aabb_tree import STACK, _box_dist2
 from .skin_contact import _face_normal
@@ -54,53 +54,60 @@ class Body(NamedTuple):
     limb: np.ndarray
 
 
-@njit(cache=True)
-def gather(x, radius, tree, mesh, out_tri):
-    """For each point, its K (out_tri's columns) nearest triangles within ``radius`` (m) with
-    no corner in its neighbourhood, nearest first (-1: none). Serial: with prange it took the
-    same 21 ms at 12.5k points with the other core busy (docs/architecture.md: serial
-    kernels by default)."""
-    n = x.shape[0]
+@njit(cache=True, inline="always")
+def _gather_one(x, i, radius, tree, mesh, out_tri, st, best, near):
+    """Point i's row of ``gather``."""
     K = out_tri.shape[1]
     lo, hi, left, right, prim = tree
-    st = np.empty(STACK, np.int64)
-    best = np.empty(K)
-    near = np.zeros(n, np.bool_)  # the point's neighbourhood, marked while it is queried
-    for i in range(n):
-        for k in range(K):
-            out_tri[i, k] = -1
-            best[k] = radius * radius
-        for k in range(mesh.start[i], mesh.start[i + 1]):
-            near[mesh.nbr[k]] = True
-        p = x[i]
-        st[0] = 0
-        top = 1
-        while top > 0:
-            top -= 1
-            node = st[top]
-            if _box_dist2(p, lo, hi, node) > best[K - 1]:
-                continue
-            e = prim[node]
-            if e < 0:
-                st[top] = left[node]
-                st[top + 1] = right[node]
-                top += 2
-                continue
-            ia, ib, ic = mesh.tris[e, 0], mesh.tris[e, 1], mesh.tris[e, 2]
-            if near[ia] or near[ib] or near[ic]:
-                continue
-            u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
-            if d2 >= best[K - 1]:
-                continue
-            k = K - 1
-            while k > 0 and best[k - 1] > d2:
-                best[k] = best[k - 1]
-                out_tri[i, k] = out_tri[i, k - 1]
-                k -= 1
-            best[k] = d2
-            out_tri[i, k] = e
-        for k in range(mesh.start[i], mesh.start[i + 1]):
-            near[mesh.nbr[k]] = False
+    for k in range(K):
+        out_tri[i, k] = -1
+        best[k] = radius * radius
+    for k in range(mesh.start[i], mesh.start[i + 1]):
+        near[mesh.nbr[k]] = True
+    p = x[i]
+    st[0] = 0
+    top = 1
+    while top > 0:
+        top -= 1
+        node = st[top]
+        if _box_dist2(p, lo, hi, node) > best[K - 1]:
+            continue
+        e = prim[node]
+        if e < 0:
+            st[top] = left[node]
+            st[top + 1] = right[node]
+            top += 2
+            continue
+        ia, ib, ic = mesh.tris[e, 0], mesh.tris[e, 1], mesh.tris[e, 2]
+        if near[ia] or near[ib] or near[ic]:
+            continue
+        u, v, w, d2 = closest_on_triangle(p, x[ia], x[ib], x[ic])
+        if d2 >= best[K - 1]:
+            continue
+        k = K - 1
+        while k > 0 and best[k - 1] > d2:
+            best[k] = best[k - 1]
+            out_tri[i, k] = out_tri[i, k - 1]
+            k -= 1
+        best[k] = d2
+        out_tri[i, k] = e
+    for k in range(mesh.start[i], mesh.start[i + 1]):
+        near[mesh.nbr[k]] = False
+
+
+@njit(cache=True, parallel=True)
+def gather(x, radius, tree, mesh, out_tri):
+    """For each point, its K (out_tri's columns) nearest triangles within ``radius`` (m) with
+    no corner in its neighbourhood, nearest first (-1: none). In parallel over chunks of
+    points, each with its own scratch (race-free: a point writes only its own row)."""
+    n = x.shape[0]
+    chunk = 256  # points per task, sharing one scratch stack and mark array
+    for c in prange((n + chunk - 1) // chunk):
+        st = np.empty(STACK, np.int64)
+        best = np.empty(out_tri.shape[1])
+        near = np.zeros(n, np.bool_)  # the point's neighbourhood, marked while it is queried
+        for i in range(c * chunk, min(n, (c + 1) * chunk)):
+            _gather_one(x, i, radius, tree, mesh, out_tri, st, best, near)
 
 
 @njit(cache=True)
