@@ -353,6 +353,26 @@ def test_garments_worn_together_are_limited_each_on_its_own():
     assert a.limit_stats[0] < b.limit_stats[0] == both.limit_stats[0]
 
 
+def test_the_strain_limit_moves_no_held_point_and_shortens_from_the_other_end():
+    """A strip stretched 20% with its bottom row held (as a last limit holds the points
+    sent back where they crossed): the held points stay exactly where they are, and every
+    structural spring still comes within its cap, its free end doing all the moving. Pinned
+    along the top, a held point beyond its long range attachment's reach is not pulled in
+    by it either."""
+    for pinned, limited in ((False, True), (None, False)):
+        net = strip_network(8, limit=0.05, pinned=pinned)
+        net.x[:, 2] *= 1.2
+        held = np.zeros(len(net.x), bool)
+        held[-11:] = limited
+        held[-6] = True
+        x0 = net.x.copy()
+        net.limit_strain(1.0 / 240.0, None, held)
+        assert np.array_equal(net.x[held], x0[held])
+        if limited:
+            assert structural_strain(net) <= 0.05 + 1e-12
+            assert net.limit_stats[1] == 0
+
+
 def test_the_strain_limit_leaves_a_contact_plane_on_its_outer_side():
     """A strip (in the x-z plane) pinned along both side edges, stretched 20% between them,
     its middle column pushed 2 cm out of the plane by a post: the half-space y >= 0.02 m.

@@ -139,7 +139,7 @@ def test_a_move_that_crosses_is_undone_where_it_crosses(layered):
     net.x[:], net.v[:] = kicked, 1.0
     crossing = {tuple(p) for p in np.sort(AABBTree(net.x, net.triangles).intersections(), axis=1)}
     assert len(crossing - allowed) > 20
-    L.undo_new_crossings(x0, v0)
+    sent = L.undo_new_crossings(x0, v0)
     after = {tuple(p) for p in np.sort(AABBTree(net.x, net.triangles).intersections(), axis=1)}
     assert after <= allowed
     back = np.all(net.x == x0, axis=1) & ~net.fixed
@@ -147,4 +147,5 @@ def test_a_move_that_crosses_is_undone_where_it_crosses(layered):
     assert np.all(back | kept | net.fixed)  # each point either back or where the kick put it
     assert back.sum() > 0 and kept.sum() > back.sum()  # most of the move stands
     assert np.all(net.v[back] == 0.0) and np.all(net.v[kept] == 1.0)
+    assert np.array_equal(sent, back)  # it names the points it sent back (held by a next limit)
     net.x[:], net.v[:] = x0, 0.0

@@ -55,7 +55,7 @@ class SkinContactParams:
     it of where the skin's weights carry it (systems.garments.Garments.tether; 0: off);
     final_limits: how often a garment worn in layers has its stretch limit run last, undone
     where it crosses (see _Projector.resolve: accuracy against speed, the runner's garments'
-    pass 17% longer for each, docs/clothing.md)."""
+    pass 4-17% longer for each, docs/clothing.md)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)
     reach: float = param(0.03, "m", gt=0.0, le=0.5)
@@ -202,12 +202,15 @@ class _Projector:
                 self.layers.guard(self.x0, h)
             # the guard's rims, shortened where that crosses nothing: the limit once more, and
             # the points of the triangles it made cross go back (the runner's tee: median
-            # frame 7.0 -> 5.7%, worst 11.9 -> 8.7%, for 17% of the garments' pass; twice,
-            # 5.0% and 8.9% for 32%; docs/clothing.md)
+            # frame 7.0 -> 5.7%, worst 11.9 -> 8.7%). A further limit holds the points sent
+            # back: it shortens their springs from the other end (run free again, they made
+            # the same crossings: twice, the tee's worst frame 8.9%, held 8.1%; three times
+            # held 6.5%; docs/clothing.md)
+            held = np.zeros(len(v.x), bool)
             for _ in range(self.p.final_limits if self.limiter is not None else 0):
                 safe_x, safe_v = v.x.copy(), v.v.copy()
-                self.limiter.limit_strain(h, Planes(near, nrm, o))
-                self.layers.undo_new_crossings(safe_x, safe_v)
+                self.limiter.limit_strain(h, Planes(near, nrm, o), held)
+                held |= self.layers.undo_new_crossings(safe_x, safe_v)
                 self.dv += v.v - safe_v
         c = np.zeros(3) if centre is None else np.asarray(centre, float)
         return reaction(v.x, v.masses, self.dv, h, c)

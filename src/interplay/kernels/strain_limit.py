@@ -76,11 +76,13 @@ def no_planes() -> Planes:
 
 
 @njit(cache=True)
-def _reach(x, reach):
+def _reach(x, w, reach):
     """Move every point of ``reach`` farther than its dist from its pin back onto that
-    sphere (the pin is fixed: only the point moves)."""
+    sphere (the pin is fixed: only the point moves; a held one, w = 0, does not)."""
     for k in range(reach.idx.shape[0]):
         p = reach.idx[k]
+        if w[p] == 0.0:
+            continue
         q = reach.pin[k]
         d0 = x[p, 0] - x[q, 0]
         d1 = x[p, 1] - x[q, 1]
@@ -150,7 +152,7 @@ def _passes(x, w, lim, a, b, reach, planes, sweeps, near):
     while taken < sweeps:
         full = since >= REFRESH
         worst = 0.0
-        _reach(x, reach)
+        _reach(x, w, reach)
         if full:
             m = 0
             since = 0

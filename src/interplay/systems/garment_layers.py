@@ -209,23 +209,27 @@ class Layers:
         moved = label >= 0
         net.v[moved] = (x[moved] - x0[moved]) / h
 
-    def undo_new_crossings(self, x_safe, v_safe) -> None:
+    def undo_new_crossings(self, x_safe, v_safe) -> np.ndarray:
         """After a move from x_safe (n,3) m (a state with no new crossing, velocities v_safe):
         the points of every triangle pair that came to cross go back to x_safe, until none
-        is left (at worst every point: x_safe)."""
+        is left (at worst every point: x_safe). Returns the points sent back (n,) bool."""
         x, v = self.net.x, self.net.v
         changed = None
+        undone = np.zeros(len(x), bool)
         for _ in range(ZONE_ROUNDS):
             new = self._new_crossings(changed)
             if not len(new):
-                return
+                return undone
             back = np.unique(self.mesh.tris[new].ravel())
             back = back[np.any(x[back] != x_safe[back], axis=1)]
             if not len(back):
                 break
             x[back], v[back] = x_safe[back], v_safe[back]
+            undone[back] = True
             changed = back
         x[:], v[:] = x_safe, v_safe
+        undone[:] = True
+        return undone
 
     def capture(self) -> dict:
         """What the next steps depend on: the candidates and the steps since they were

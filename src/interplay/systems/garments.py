@@ -105,15 +105,16 @@ class Garments(SpringNetwork):
             # the velocity is the last substep's: x - x_n = (h / n) v
             self.limit_strain(h / substeps(h, self.dt if dt is None else dt))
 
-    def limit_strain(self, h: float, planes=None) -> None:
+    def limit_strain(self, h: float, planes=None, held=None) -> None:
         """Shorten the structural springs stretched past their fabric's limit back to it
         (kernels/strain_limit.py: Provot's correction, shared by inverse mass, so the points'
         linear momentum is kept; pinned points stay), keeping the points of ``planes`` (a
         strain_limit.Planes: a contact's half-spaces) on their outer sides; the velocities
-        change by the move over the step h (s)."""
+        change by the move over the step h (s). held (n,) bool: points kept where they are,
+        as the pinned ones (None: none)."""
         if not len(self.limits.i):
             return
-        w = np.where(self.fixed, 0.0, 1.0 / self.m)
+        w = np.where(self.fixed if held is None else self.fixed | held, 0.0, 1.0 / self.m)
         planes = SL.no_planes() if planes is None else planes
         o, start = SL.starts(self.part, planes.idx, len(self.parts))
         passes, left = SL.limit_strain(self.x, self.v, w, self.limits, self.limit_start,
