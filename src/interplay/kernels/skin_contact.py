@@ -10,7 +10,7 @@ weights ``bary``, its signed distance ``s`` (m, negative inside) and outward nor
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 class Skin(NamedTuple):
@@ -85,6 +85,165 @@ def project(pts, x0, skin, near, law, dv):
         nvz = vbz + keep * tz / h + un * nz
         dv[i, 0], dv[i, 1], dv[i, 2] = nvx - pts.v[i, 0], nvy - pts.v[i, 1], nvz - pts.v[i, 2]
         pts.v[i, 0], pts.v[i, 1], pts.v[i, 2] = nvx, nvy, nvz
+    return count
+
+
+#: skin edges farther than this many thicknesses from a cloth edge are not its contacts (the
+#: deepest a ridge can be through an edge whose points are out: its sag, a few millimetres)
+EDGE_REACH = 2.0
+
+
+@njit(cache=True, inline="always")
+def _lines_closest(x, a, b, X, p, q):
+    """The closest points of the lines through segments (x[a], x[b]) and (X[p], X[q]): their
+    parameters (s, u) along each and the squared distance (inf for parallel lines). Inside
+    both segments (0 < s, u < 1) they are the segments' own closest points."""
+    d10, d11, d12 = x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2]
+    d20, d21, d22 = X[q, 0] - X[p, 0], X[q, 1] - X[p, 1], X[q, 2] - X[p, 2]
+    r0, r1, r2 = x[a, 0] - X[p, 0], x[a, 1] - X[p, 1], x[a, 2] - X[p, 2]
+    A = d10 * d10 + d11 * d11 + d12 * d12
+    E = d20 * d20 + d21 * d21 + d22 * d22
+    B = d10 * d20 + d11 * d21 + d12 * d22
+    C = d10 * r0 + d11 * r1 + d12 * r2
+    F = d20 * r0 + d21 * r1 + d22 * r2
+    den = A * E - B * B
+    if den <= 1e-12 * A * E:
+        return -1.0, -1.0, np.inf
+    s = (B * F - C * E) / den
+    u = (A * F - B * C) / den
+    e0, e1, e2 = r0 + s * d10 - u * d20, r1 + s * d11 - u * d21, r2 + s * d12 - u * d22
+    return s, u, e0 * e0 + e1 * e1 + e2 * e2
+
+
+@njit(cache=True)
+def _deepest_edge(pts, a, b, skin, across, tri, reach, cand):
+    """The skin edge nearest cloth edge (a, b) along its pseudonormal, among the edges of the
+    triangles its points found (tri) and the triangles across their edges, whose closest
+    points to it lie strictly inside both segments (a corner's contact is a point's) and within
+    ``reach`` (m) of it. Returns (signed gap along the normal, m: inf if none; s, u: the
+    closest points' parameters on the cloth and skin edges; the skin edge's ends p, q; its
+    unit pseudonormal)."""
+    nc = 0
+    for t0 in (tri[a], tri[b]):
+        for j in range(-1, 3):
+            t = t0 if j < 0 else across[t0, j]
+            seen = t < 0
+            for c in range(nc):
+                seen = seen or cand[c] == t
+            if not seen:
+                cand[nc] = t
+                nc += 1
+    best, bs, bu, bp, bq, m0, m1, m2 = np.inf, 0.0, 0.0, -1, -1, 0.0, 0.0, 0.0
+    x = pts.x
+    for c in range(nc):
+        t = cand[c]
+        for j in range(3):
+            p, q = skin.tris[t, j], skin.tris[t, (j + 1) % 3]
+            sc, uc, d2 = _lines_closest(x, a, b, skin.X, p, q)
+            if sc <= 0.0 or sc >= 1.0 or uc <= 0.0 or uc >= 1.0 or d2 > reach * reach:
+                continue
+            if across[t, j] < 0:
+                continue
+            # the edge's pseudonormal: the sum of its two faces' normals (exact for the side
+            # of a point whose closest feature is the edge; Baerentzen & Aanaes 2005)
+            f = _face_normal(skin.X, skin.tris, t)
+            g = _face_normal(skin.X, skin.tris, across[t, j])
+            n0, n1, n2 = f[0] + g[0], f[1] + g[1], f[2] + g[2]
+            nl = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            if nl == 0.0:
+                continue
+            gap = 0.0
+            for r, nr in ((0, n0), (1, n1), (2, n2)):
+                gap += ((1.0 - sc) * x[a, r] + sc * x[b, r]
+                        - (1.0 - uc) * skin.X[p, r] - uc * skin.X[q, r]) * nr / nl
+            if gap < best:
+                best, bs, bu, bp, bq = gap, sc, uc, p, q
+                m0, m1, m2 = n0 / nl, n1 / nl, n2 / nl
+    return best, bs, bu, bp, bq, np.array((m0, m1, m2))
+
+
+@njit(cache=True, parallel=True)
+def _edges_near(pts, edges, skin, across, tri, s, law, out):
+    """out (k,) bool: the cloth edges (edges (k,2)) that ``project_edges`` resolves (both
+    points found a skin triangle, not both fixed, a skin edge nearer than the thickness).
+    In parallel over chunks of edges: the look is most of the cost, and few are near."""
+    chunk = 1024
+    for c in prange((edges.shape[0] + chunk - 1) // chunk):
+        cand = np.empty(8, np.int64)
+        for k in range(c * chunk, min(edges.shape[0], (c + 1) * chunk)):
+            a, b = edges[k, 0], edges[k, 1]
+            out[k] = False
+            if tri[a] < 0 or tri[b] < 0 or (pts.fixed[a] and pts.fixed[b]):
+                continue
+            # a skin edge within REACH of the edge's point at t is within t L + REACH of a
+            # and (1 - t) L + REACH of b, neither nearer than its own nearest skin point (s,
+            # before the point contact put it out: no farther)
+            L = np.sqrt((pts.x[a, 0] - pts.x[b, 0]) ** 2 + (pts.x[a, 1] - pts.x[b, 1]) ** 2
+                        + (pts.x[a, 2] - pts.x[b, 2]) ** 2)
+            if s[a] + s[b] >= L + 2.0 * EDGE_REACH * law.thickness:
+                continue
+            gap = _deepest_edge(pts, a, b, skin, across, tri, EDGE_REACH * law.thickness, cand)[0]
+            out[k] = gap < law.thickness
+
+
+@njit(cache=True)
+def project_edges(pts, x0, edges, skin, across, near, law, dv):
+    """Edge-edge contacts, after ``project`` has put every point out: a skin ridge can still
+    pass between a cloth edge's two points (the edge sags through it while both points are
+    outside). Each cloth edge (a, b) (edges (k,2)) whose points both found a skin triangle
+    (near: the points' Nearest, before ``project``) is
+    held off its deepest skin edge (``_deepest_edge``, within EDGE_REACH thicknesses) by the
+    thickness along that edge's pseudonormal n: its two points move along n in proportion to
+    their weights at the closest point (1 - s, s; a fixed point does not move), so that the
+    closest point moves out by the missing gap; friction acts on that point's slip over the
+    step as in ``project`` (undone up to mu times the push, distributed the same way). Each
+    point loses the part of its velocity relative to the skin that approaches it along n, and
+    takes the friction's change per step. dv (n,3) receives the velocity changes (added);
+    returns the contacts. An edge with a fixed end is held only where its closest point is
+    on its free half (nearer the fixed end, its free point would move more than twice the
+    push). The edges near are found in parallel (``_edges_near``), then resolved in turn."""
+    count = 0
+    h = law.h
+    cand = np.empty(8, np.int64)
+    tri = near.tri
+    close = np.empty(edges.shape[0], np.bool_)
+    _edges_near(pts, edges, skin, across, tri, near.s, law, close)
+    for k in np.flatnonzero(close):
+        a, b = edges[k, 0], edges[k, 1]
+        gap, s, u, p, q, n = _deepest_edge(pts, a, b, skin, across, tri,
+                                           EDGE_REACH * law.thickness, cand)
+        wa = 0.0 if pts.fixed[a] else 1.0 - s
+        wb = 0.0 if pts.fixed[b] else s
+        if gap >= law.thickness or wa * wa + wb * wb < 0.25:
+            continue
+        count += 1
+        lam = 1.0 / (wa * wa + wb * wb)  # a move m of the closest point: wa lam m, wb lam m
+        push = law.thickness - gap
+        # the closest point's slip over the step relative to the skin's, tangent to it
+        slip = np.empty(3)
+        vs = np.empty(3)
+        for r in range(3):
+            vs[r] = (1.0 - u) * skin.V[p, r] + u * skin.V[q, r]
+            slip[r] = ((1.0 - s) * (pts.x[a, r] - x0[a, r]) + s * (pts.x[b, r] - x0[b, r])
+                       - vs[r] * h)
+        sn = slip[0] * n[0] + slip[1] * n[1] + slip[2] * n[2]
+        slip -= sn * n
+        length = np.sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2])
+        cap = law.friction * push
+        undo = 1.0 if length <= cap else cap / length
+        for i, w in ((a, wa), (b, wb)):
+            if w == 0.0:
+                continue
+            for r in range(3):
+                move = w * lam * (push * n[r] - undo * slip[r])
+                pts.x[i, r] += move
+            un = 0.0
+            for r in range(3):
+                un += (pts.v[i, r] - vs[r]) * n[r]
+            for r in range(3):
+                dvr = -min(un, 0.0) * n[r] - w * lam * undo * slip[r] / h
+                pts.v[i, r] += dvr
+                dv[i, r] += dvr
     return count
 
 
