@@ -20,7 +20,7 @@ cannot overshoot.
 
 The garments of one network share no point, so each garment's passes run on their own, the
 garments in parallel (a tee and sweat pants: 0.7x the time of one after the other on the
-two cores): the springs, reaches and planes come grouped by garment (``start``: each
+two cores): the springs, reaches and planes come grouped by garment (``starts``: each
 garment's first entry, then the count).
 
 Notation (SI): points x (n,3) m, velocities v (n,3) m/s, inverse masses w (n,) 1/kg (0:
