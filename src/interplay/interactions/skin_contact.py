@@ -58,7 +58,7 @@ class SkinContactParams:
     where it crosses (see _Projector.resolve: accuracy against speed, the runner's garments'
     pass 4-17% longer for each, docs/clothing.md); edges: each cloth edge also held off the
     skin's edges (kernels/skin_contact.project_edges: a ridge sharper than the cloth's
-    spacing can pass between two points held off it; the runner's garments' pass 9% longer,
+    spacing can pass between two points held off it; the runner's garments' pass 15% longer,
     and neither scene has such a crossing without it, so off by default)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)

@@ -92,9 +92,6 @@ class Layers:
                + identity(n, format="csr"))
         ring = (adj @ adj).tocsr()
         ring.sort_indices()
-        layer = np.zeros(n, np.int64)
-        for k, idx in enumerate(net.parts.values()):  # the garments in the order put on
-            layer[idx] = k
         # each point's limb: its nearest skin vertex's where it was cut, among the limbs its
         # garment covers (a tee's hem hangs beside the thighs: it is the trunk's)
         skin = surface.vertex_limbs()
@@ -105,7 +102,7 @@ class Layers:
             nearest = cKDTree(surface.vertices0[on]).query(net.garment.vertices[idx])[1]
             limb[idx] = skin[on[nearest]]
         self.mesh = CL.Mesh(tris, ring.indptr.astype(np.int64), ring.indices.astype(np.int64),
-                            layer, limb)
+                            net.part, limb)
         self.tree = AABBTree(net.x, tris, owner=f"{net.name} layers")
         self.tri = np.full((n, CANDIDATES), -1, np.int64)
         self.side = np.zeros((n, CANDIDATES))

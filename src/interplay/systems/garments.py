@@ -74,8 +74,8 @@ class Garments(SpringNetwork):
         for p in (garment.parts or (garment,)):
             limit[self.parts[p.name]] = p.fabric.stretch_limit
         on = (kind == 0) & ~self.band & np.isfinite(limit[self.si])
-        # the limit runs each garment on its own (kernels/strain_limit.py): its springs and
-        # reaches grouped by garment
+        # each point's garment, in the order put on (the limit runs each on its own,
+        # kernels/strain_limit.py; the layers tell inner from outer, garment_layers.py)
         self.part = np.zeros(len(self.x), np.int64)
         for k, idx in enumerate(self.parts.values()):
             self.part[idx] = k
