@@ -191,7 +191,13 @@ def test_the_skins_signed_distance_tells_the_side_exactly_off_thin_parts(runner_
 def test_the_panels_sew_into_closed_garments_of_the_stated_size(surface):
     """Welded seams leave only the openings: a tee has its hem, neck and two sleeve ends, a
     vest its hem, neck and two armholes, pants a waist and two cuffs, a skirt a waist and a
-    hem; every edge belongs to one or two triangles. The tee's chest grows by 2 pi times the
+    hem; every edge belongs to one or two triangles. The skirt is cut in gores: its waist has
+    fewer columns than its hem, its edges are within the spacings the sewing evens them to
+    (Fit.shortest, Fit.split), and no triangle of it crosses another (the exact test: cut
+    with its hem's columns up to the waist, the swing's cut crossed itself in 1,619 pairs on
+    this body, 563 on the child's). (The tee's
+    shoulder tips and the pants' cuffs still cross in a few pairs at some spacings; the
+    layers' untangling undoes them in the dressing.) The tee's chest grows by 2 pi times the
     ease (a ring ``ease`` farther out all round) within 15% of that growth (the ring is the
     convex hull of the body's section, which the ease rounds); the pants reach the ankle."""
     fit = G.Fit(spacing=0.02)
@@ -204,6 +210,14 @@ def test_the_panels_sew_into_closed_garments_of_the_stated_size(surface):
         assert counts.max() <= 2, name
         assert len(G.boundary_loops(g.triangles)) == openings, name
         made[name] = g
+    sk = G.skirt(surface, G.Fit(spacing=0.02, length=0.6, ease=0.05))  # the swing's cut
+    assert len(AABBTree(sk.vertices, sk.triangles).intersections()) == 0
+    assert sk.sizes["waist_columns"] < sk.sizes["columns"]
+    e, _, _ = edges(sk.triangles)
+    length = np.linalg.norm(np.diff(sk.vertices[e], axis=1)[:, 0], axis=1)
+    # the evening's bounds, less a hair: the push out of the body after it moves a few points
+    assert fit.shortest * fit.spacing * 0.95 < length.min()
+    assert length.max() < fit.split * fit.spacing * 1.05
     loose = G.tee(surface, G.Fit(spacing=0.02, ease=0.03)).sizes["chest_girth"]
     chest = made["tee"].sizes["chest_girth"]
     growth = 2 * np.pi * (0.03 - fit.ease)

@@ -59,9 +59,9 @@ class Fabric:
 
 
 #: measured fabrics (docs/clothing.md gives the sources and how the values were taken; the
-#: stretch limits are chosen there: 5%, the cotton tee's bar of issue 16, for the tee's jersey
-#: and the pants' fleece; the skirt's twill is not limited: held to 5%, the swing's skirt, cut
-#: too short for her seated lap, crumpled at her hip and its self-crossings rose 2.7-5x,
+#: stretch limits are chosen there: 5%, the cotton tee's bar of issue 16, for all three: a
+#: woven twill stretches less than a knit. The skirt held to it once crumpled at her hip and
+#: crossed itself 2.7-5x more; cut in gores and held off itself by its layers it does not,
 #: docs/swing.md)
 FABRICS = {
     "cotton_jersey": Fabric("cotton jersey", density=0.16, tensile=400.0, shear=60.0,
@@ -70,7 +70,7 @@ FABRICS = {
     "fleece": Fabric("polyester fleece", density=0.28, tensile=250.0, shear=40.0,
                      bending=8.0e-6, friction=0.6, thickness=0.002, stretch_limit=0.05),
     "cotton_twill": Fabric("cotton twill", density=0.22, tensile=2000.0, shear=150.0,
-                           bending=1.5e-5, friction=0.5, thickness=0.0007),
+                           bending=1.5e-5, friction=0.5, thickness=0.0007, stretch_limit=0.05),
 }
 
 
@@ -146,8 +146,31 @@ class _Builder:
             else:
                 self.tris += [[a[i], a[j], b[i]], [a[j], b[j], b[i]]]
 
+    def bridge(self, a, ta, b, tb):
+        """Triangles between closed index rows a and b of any lengths, their vertices at
+        increasing angles ta, tb (rad) from 0: each next triangle steps along the row whose
+        next vertex comes first round the ring (a gore's rows, rows of equal length as
+        ``band`` with its diagonals all one way)."""
+        if len(a) == len(b):
+            return self.band(a, b)
+        na, nb = len(a), len(b)
+        ta, tb = np.append(ta, 2 * np.pi), np.append(tb, 2 * np.pi)
+        i = j = 0
+        while i < na or j < nb:
+            if j == nb or (i < na and ta[i + 1] <= tb[j + 1]):
+                self.tris.append([a[i], a[(i + 1) % na], b[j % nb]])
+                i += 1
+            else:
+                self.tris.append([a[i % na], b[(j + 1) % nb], b[j]])
+                j += 1
+
     def arrays(self):
         return np.concatenate(self.x), np.asarray(self.tris, np.int64)
+
+
+#: m: below its waistband a skirt's ease grows from the band's to the fit's over this much (a
+#: yoke): the full ease one row below the band made a shelf of long edges there
+SKIRT_YOKE = 0.05
 
 
 def _columns(circumference, spacing, multiple=4):
@@ -496,44 +519,55 @@ def sweatpants(surface: BodySurface, fit: Fit = PANTS_FIT,
 
 def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
           fabric: Fabric = FABRICS["cotton_twill"], name: str = "skirt") -> Garment:
-    """An A-line skirt: an elastic waistband at the waist, flaring by ``fit.flare`` degrees,
-    its hem ``fit.length`` of the thigh below the hip joints."""
+    """An A-line skirt cut in gores: an elastic waistband fitted to the body at the waist,
+    below it the skirt flaring by ``fit.flare`` degrees, its ease growing from the band's to
+    ``fit.ease`` over SKIRT_YOKE, its hem ``fit.length`` of the thigh below the hip joints.
+    Each row has the columns its girth holds at the spacing (``_columns``; the gores): with
+    the hem's columns all the way up, the waist's ring edges were a quarter of the spacing,
+    and lengthened after sewing (``Fit.shortest``) they buckled the waist over itself (563
+    crossing triangle pairs in the cut skirt)."""
     P = {s.name: k for k, s in enumerate(surface.plan)}
     pos0 = surface.pos0
     hips = BF.parts(surface, ("pelvis", "l_thigh", "r_thigh", "l_shank", "r_shank"))
     z_w = pos0[P["torso"], 2] - 0.01
     thigh = float(np.linalg.norm(surface.plan[P["l_thigh"]].bone))
     z_hem = pos0[P["l_thigh"], 2] - fit.length * thigh
-    probe = BF.ring(surface, hips, np.array([0.0, 0.0, z_w - 0.1]), np.array([1.0, 0, 0]),
-                  np.array([0, 1.0, 0]), np.linspace(0, 2 * np.pi, 180, endpoint=False),
-                  fit.ease)
-    hem_r = np.linalg.norm(probe[:, :2], axis=1).max() + (z_w - z_hem) * np.tan(
-        np.radians(fit.flare))
-    N = _columns(2 * np.pi * hem_r, fit.spacing, 4)
-    th = 2 * np.pi * np.arange(N) / N
     zs = np.linspace(z_w, z_hem, max(4, int(np.ceil((z_w - z_hem) / fit.spacing)) + 1))
-    b = _Builder()
-    rows = []
-    waist = BF.ring(surface, hips, np.array([0.0, 0.0, z_w]), np.array([1.0, 0, 0]),
-                  np.array([0, 1.0, 0]), th, fit.band_ease)
-    # (the skirt's waistband grips like the pants')
-    r_w = np.linalg.norm(waist[:, :2], axis=1)
+    probe = np.linspace(0, 2 * np.pi, 180, endpoint=False)
+
+    def radii(z, ease):  # the body's ring at height z with that ease, at the probe's angles
+        ring = BF.ring(surface, hips, np.array([0.0, 0.0, z]), np.array([1.0, 0, 0]),
+                       np.array([0, 1.0, 0]), probe, ease, allow_empty=True)
+        return np.linalg.norm(ring[:, :2], axis=1)
+
+    r_w = radii(z_w, fit.band_ease)  # (the skirt's waistband grips like the pants')
     tan = np.tan(np.radians(fit.flare))
     band = 0.03
+    b = _Builder()
+    rows, angles = [], []
     for z in zs:
-        body = BF.ring(surface, hips, np.array([0.0, 0.0, z]), np.array([1.0, 0, 0]),
-                     np.array([0, 1.0, 0]), th, fit.ease, allow_empty=True)
-        r = np.maximum(np.linalg.norm(body[:, :2], axis=1), r_w + (z_w - z) * tan)
-        if z > z_w - band:
-            r = r_w
-        rows.append(b.add(np.stack([r * np.cos(th), r * np.sin(th), np.full(N, z)], 1)))
-    for a, c in zip(rows[:-1], rows[1:]):
-        b.band(a, c)
+        depth = z_w - z
+        if depth < band:  # the waistband, fitted where it sits
+            r = np.maximum(radii(z, fit.band_ease), r_w)
+        else:
+            f = min(1.0, (depth - band) / SKIRT_YOKE)
+            ease = fit.band_ease + (fit.ease - fit.band_ease) * f * f * (3 - 2 * f)
+            r = np.maximum(radii(z, ease), r_w + depth * tan)
+        ring = np.stack([r * np.cos(probe), r * np.sin(probe)], 1)
+        th = 2 * np.pi * np.arange(_columns(BF.circumference(ring), fit.spacing, 4))
+        th /= len(th)
+        rr = np.interp(th, probe, r, period=2 * np.pi)
+        rows.append(b.add(np.stack([rr * np.cos(th), rr * np.sin(th), np.full(len(th), z)], 1)))
+        angles.append(th)
+        if len(rows) > 1:
+            b.bridge(rows[-2], angles[-2], rows[-1], angles[-1])
     bandrows = [r for z, r in zip(zs, rows) if z > z_w - band]
     groups = {"waist": rows[0].copy(), "waistband": np.concatenate(bandrows),
               "hem": rows[-1].copy(), "pinned": np.concatenate(bandrows)}
-    sizes = {"waist_girth": BF.circumference(waist), "length": float(z_w - z_hem),
-             "hem_girth": BF.circumference(np.concatenate(b.x)[rows[-1]]), "columns": N}
+    x = np.concatenate(b.x)
+    sizes = {"waist_girth": BF.circumference(x[rows[0]]), "length": float(z_w - z_hem),
+             "hem_girth": BF.circumference(x[rows[-1]]), "columns": len(rows[-1]),
+             "waist_columns": len(rows[0])}
     return _finish(name, b, surface, fabric, fit, groups,
                    [(_ring_edges(bandrows), fit.elastic)], sizes)
 
