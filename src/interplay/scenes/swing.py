@@ -93,6 +93,12 @@ class SwingSceneParams:
     dt: float = param(1e-3, "s", ge=1e-5, le=5e-3)
 
 
+#: m: the seat as the skirt sees it reaches this far under the board (seat_primitive), in the
+#: dressing and the run: fabric pushed into the 2 cm board by her thighs, deeper than its
+#: middle, went out through its bottom from the first frame (21-53 points under it in 2 s,
+#: the skirt held to 5%); with the pedestal the nearest way out is up or past an edge (1-3
+#: points under it in 2 s; docs/swing.md). The price: fabric cannot swing under the seat
+PEDESTAL = 0.3
 SKIRT_COLOR = (0.55, 0.08, 0.30)  # linear RGB: a plum-red skirt against the blue frame
 _DRESSED: dict = {}  # (params, step) -> (surface, skirt, dressed points, velocities, report)
 
@@ -109,10 +115,9 @@ def dressed_skirt(fig: SwingFigure, p: SkirtParams, h: float):
         net = _network(garment, h, surface, p.layers)
         # little friction while dressing, so the fabric slides into place (the runner's)
         # the seat joins for the settling: while she is moved into her seated pose the
-        # skirt's back hangs through where the seat is; at rest a pedestal under the board
-        # pushes it the short way out, up onto the seat or back past its edge
-        seat = PartContact("skirt-seat", fig, net, p.seat, mode="one-way", parts=(),
-                           extra=(("swing", seat_primitive(fig.swing, below=0.3)),))
+        # skirt's back hangs through where the seat is; at rest the pedestal pushes it the
+        # short way out, up onto the seat or back past its edge
+        seat = _seat(fig, net, p, "one-way")
         report = dress(net, surface, pos, R, p.dress_s, p.settle_s, h,
                        replace(p.contact, friction=0.05),
                        skin_velocity=PosedSkin(fig, surface).now()[1], tether=p.contact.tether,
@@ -132,6 +137,12 @@ def _network(garment, h, surface, layers):
     if layers > 0:  # one garment over one limb: each fold held on the side it is on
         net.layers = Layers(net, surface, layers, covers={garment.name: ("trunk",)})
     return net
+
+
+def _seat(fig: SwingFigure, net, p: SkirtParams, coupling: str) -> PartContact:
+    """The skirt on her seat: the board as a box with PEDESTAL under it (seat_primitive)."""
+    return PartContact("skirt-seat", fig, net, p.seat, mode=coupling, parts=(),
+                       extra=(("swing", seat_primitive(fig.swing, below=PEDESTAL)),))
 
 
 def child(p: SwingSceneParams, dt: float | None = None) -> SwingFigure:
@@ -172,8 +183,7 @@ def build(coupling: str = "one-way", duration: float = 12.0, fps: float = 30.0,
         scene.add(net)
         scene.connect(SkinContact("skirt-body", fig, net, surface, params.skirt.contact,
                                   mode=coupling))
-        scene.connect(PartContact("skirt-seat", fig, net, params.skirt.seat, mode=coupling,
-                                  parts=("swing",)))
+        scene.connect(_seat(fig, net, params.skirt, coupling))
         net.watch(PosedSkin(fig, surface))
         g = net.garment
         meta = {"skirt": {"mass_kg": g.mass, "fabric": g.fabric.name, "sizes": g.sizes,
