@@ -523,7 +523,7 @@ def skirt(surface: BodySurface, fit: Fit = Fit(length=0.75, ease=0.01),
     below it the skirt flaring by ``fit.flare`` degrees, its ease growing from the band's to
     ``fit.ease`` over SKIRT_YOKE, its hem ``fit.length`` of the thigh below the hip joints.
     Each row has the columns its girth holds at the spacing (``_columns``; the gores): with
-    the hem's columns all the way up, the waist's ring edges were a quarter of the spacing,
+    the hem's columns all the way up, the waist's ring edges were a third of the spacing,
     and lengthened after sewing (``Fit.shortest``) they buckled the waist over itself (563
     crossing triangle pairs in the cut skirt)."""
     P = {s.name: k for k, s in enumerate(surface.plan)}
