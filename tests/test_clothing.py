@@ -387,6 +387,31 @@ def test_the_strain_limit_moves_no_held_point_and_shortens_from_the_other_end():
             assert net.limit_stats[1] == 0
 
 
+def test_the_final_limits_may_bring_cloth_to_the_final_gap_and_no_nearer():
+    """The skin contact's half-spaces for a limit after its projection (skin_contact.kept_off):
+    a strip pinned along both side edges, stretched 20%, its middle column 8 mm off a skin at
+    y = 0.012 m (outward +y), one point of it 0.5 mm off. Pulled towards the pins' plane the
+    column comes to rest exactly at the gap (5 mm, the contact's thickness; 2 mm, a final
+    gap), less stretched the nearer it may come; the point already within the gap comes no
+    nearer."""
+    from interplay.interactions.skin_contact import kept_off
+    strain = {}
+    for gap in (0.005, 0.002):
+        net = strip_network(11, cols=11, limit=0.05, pinned=np.r_[0:121:11, 10:121:11])
+        net.x[:, 0] *= 1.2
+        mid = np.flatnonzero(np.isclose(net.x[:, 0], 0.06))
+        net.x[mid, 1] = 0.02
+        net.x[mid[0], 1] = 0.0125
+        s = net.x[mid, 1] - 0.012
+        net.limit_strain(1.0 / 240.0, kept_off(mid, np.tile([0.0, 1.0, 0.0], (len(mid), 1)),
+                                               net.x[mid], s, gap))
+        y = net.x[mid, 1]
+        np.testing.assert_allclose(y[1:], 0.012 + gap, atol=1e-12)  # round-off of a plane
+        assert y[0] >= 0.0125 - 1e-12
+        strain[gap] = structural_strain(net)
+    assert strain[0.002] < strain[0.005]
+
+
 def test_the_strain_limit_leaves_a_contact_plane_on_its_outer_side():
     """A strip (in the x-z plane) pinned along both side edges, stretched 20% between them,
     its middle column pushed 2 cm out of the plane by a post: the half-space y >= 0.02 m.

@@ -58,14 +58,17 @@ class SkinContactParams:
     where it crosses (see _Projector.resolve: accuracy against speed, the runner's garments'
     pass 4-17% longer for each, docs/clothing.md); edges: each cloth edge also held off the
     skin's edges (kernels/skin_contact.project_edges: a ridge sharper than the cloth's
-    spacing can pass between two points held off it; the runner's garments' pass 15% longer,
-    and neither scene has such a crossing without it, so off by default)."""
+    spacing can pass between two points held off it; the runner's garments' pass 15% longer
+    and it has no such crossing without it, so off by default; on for the swing's skirt);
+    final_gap (m): how near the skin the final limits may bring a point (the thickness if
+    more, as by default; 2 mm with three final limits: the runner's tee within 5.5%)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)
     reach: float = param(0.03, "m", gt=0.0, le=0.5)
     tether: float = param(0.03, "m", ge=0.0, le=1.0, doc="0: none")
     final_limits: int = param(1, "passes", ge=0, le=5, doc="0: fastest")
     edges: bool = param(False, doc="edge-edge contact with the skin too")
+    final_gap: float = param(0.005, "m", ge=0.0, le=0.1, doc="the thickness if more")
 
 
 class PosedSkin:
@@ -100,6 +103,14 @@ class PosedSkin:
 RELIMITS = 1
 #: m: the least a point that rides the skin is kept off it (see resolve)
 RIDE_OFF = 0.001
+
+
+def kept_off(idx, n, x, s, gap: float) -> Planes:
+    """The half-spaces (kernels/strain_limit.Planes) that keep points idx (k,) at x (k,3) m,
+    found s (k,) m off the skin along its outward normals n (k,3), at least ``gap`` (m) off
+    it in a move after the projection (a stretch limit): n . x' >= n . x + gap - max(s, gap),
+    so a point farther than gap may come to it, and one nearer may not come nearer."""
+    return Planes(idx, n, np.einsum("ij,ij->i", n, x) + gap - np.maximum(s, gap))
 
 
 class _Projector:
@@ -184,11 +195,14 @@ class _Projector:
             # tangent plane: n . x >= n . x_now + thickness - max(s, thickness) (a point
             # just pushed out stays where it is along n)
             near = np.flatnonzero(tri >= 0)
-            nrm = self.n[near]
-            o = (np.einsum("ij,ij->i", nrm, v.x[near]) + self.p.thickness
-                 - np.maximum(self.s[near], self.p.thickness))
+            planes = kept_off(near, self.n[near], v.x[near], self.s[near], self.p.thickness)
+            # the final limits (below) may bring a point nearer, to final_gap: a pleat lying on
+            # her chest then flattens towards the skin instead of crossing itself (docs/
+            # clothing.md: the runner's tee within 5.5% with three)
+            final = kept_off(near, self.n[near], v.x[near], self.s[near],
+                             min(self.p.final_gap, self.p.thickness))
             before = v.v.copy()
-            self.limiter.limit_strain(h, Planes(near, nrm, o))
+            self.limiter.limit_strain(h, planes)
             # the limit's own velocity changes join the contact's in the reaction: its
             # corrections along springs are equal and opposite pairs on one line (no net
             # force or torque), so what remains is the skin's push through the planes and
@@ -209,7 +223,7 @@ class _Projector:
             self.layers.guard(self.x0, h, follow)
             for _ in range(RELIMITS if self.limiter is not None else 0):
                 before = v.v.copy()
-                self.limiter.limit_strain(h, Planes(near, nrm, o))
+                self.limiter.limit_strain(h, planes)
                 self.dv += v.v - before
                 self.layers.guard(self.x0, h)
             # the guard's rims, shortened where that crosses nothing: the limit once more, and
@@ -221,7 +235,7 @@ class _Projector:
             held = np.zeros(len(v.x), bool)
             for _ in range(self.p.final_limits if self.limiter is not None else 0):
                 safe_x, safe_v = v.x.copy(), v.v.copy()
-                self.limiter.limit_strain(h, Planes(near, nrm, o), held)
+                self.limiter.limit_strain(h, final, held)
                 held |= self.layers.undo_new_crossings(safe_x, safe_v)
                 self.dv += v.v - safe_v
         c = np.zeros(3) if centre is None else np.asarray(centre, float)
