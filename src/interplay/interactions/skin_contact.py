@@ -61,7 +61,8 @@ class SkinContactParams:
     spacing can pass between two points held off it; the runner's garments' pass 15% longer
     and it has no such crossing without it, so off by default; on for the swing's skirt);
     final_gap (m): how near the skin the final limits may bring a point (the thickness if
-    more, as by default; 2 mm with three final limits: the runner's tee within 5.5%)."""
+    more, as by default; 2 mm with three final limits: the runner's tee at 5.0% at frame 0
+    and the median frame, 5.5-7.2% at the worst, docs/clothing.md)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)
     reach: float = param(0.03, "m", gt=0.0, le=0.5)
@@ -198,7 +199,7 @@ class _Projector:
             planes = kept_off(near, self.n[near], v.x[near], self.s[near], self.p.thickness)
             # the final limits (below) may bring a point nearer, to final_gap: a pleat lying on
             # her chest then flattens towards the skin instead of crossing itself (docs/
-            # clothing.md: the runner's tee within 5.5% with three)
+            # clothing.md, "The final gap")
             final = kept_off(near, self.n[near], v.x[near], self.s[near],
                              min(self.p.final_gap, self.p.thickness))
             before = v.v.copy()
