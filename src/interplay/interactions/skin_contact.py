@@ -200,8 +200,8 @@ class _Projector:
             # the final limits (below) may bring a point nearer, to final_gap: a pleat lying on
             # her chest then flattens towards the skin instead of crossing itself (docs/
             # clothing.md, "The final gap")
-            final = kept_off(near, self.n[near], v.x[near], self.s[near],
-                             min(self.p.final_gap, self.p.thickness))
+            final = (planes if self.p.final_gap >= self.p.thickness else
+                     kept_off(near, self.n[near], v.x[near], self.s[near], self.p.final_gap))
             before = v.v.copy()
             self.limiter.limit_strain(h, planes)
             # the limit's own velocity changes join the contact's in the reaction: its
