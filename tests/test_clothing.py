@@ -412,6 +412,49 @@ def test_the_final_limits_may_bring_cloth_to_the_final_gap_and_no_nearer():
     assert strain[0.002] < strain[0.005]
 
 
+def test_cloth_the_projection_moved_out_may_come_to_the_final_gap(surface):
+    """The final limits start from where the skin's projection left each point: a jersey
+    strip 10 x 4 cm on the chest, pinned 3 mm off the skin along its side edges and cut 1/1.2
+    of that size (more stretch than the limit can take back: it pulls the middle towards the
+    pins as far as the skin lets it), its middle column found 1 mm inside the skin. The
+    projection moves that column out to the thickness (5 mm) and the first limit holds it
+    there; the final limit brings it to the final gap (2 mm). Taking the distance found
+    before the projection, it stayed at 5 mm: the final gap never reached cloth lying on the
+    skin (the runner's tee pleats)."""
+    from interplay.systems.garment_layers import Layers
+    X = surface.vertices0
+    trunk = np.flatnonzero(surface.vertex_limbs() == list(LIMBS).index("trunk"))
+    chest = trunk[np.abs(X[trunk, 2] - 1.3) < 0.03]
+    p = X[chest[np.argmax(X[chest, 0])]]  # the chest's front (+x) at 1.3 m
+    n = surface.mesh_distance(p[None])[1][0]
+    across = np.cross(n, [0.0, 0.0, 1.0])
+    across /= np.linalg.norm(across)
+    a, b = np.meshgrid((np.arange(11) - 5) * 0.01, (np.arange(5) - 2) * 0.01)
+    a, b = a.ravel(), b.ravel()
+    x = p + a[:, None] * across + b[:, None] * np.cross(n, across)
+    for _ in range(5):  # draped 3 mm off the skin
+        s, nrm = surface.mesh_distance(x)
+        x += (0.003 - s)[:, None] * nrm
+    mid = np.flatnonzero(a == 0.0)
+    x[mid] -= 0.004 * nrm[mid]
+    q = (np.arange(4)[:, None] * 11 + np.arange(10)).ravel()
+    tris = np.concatenate([np.stack([q, q + 1, q + 11], 1), np.stack([q + 1, q + 12, q + 11], 1)])
+    rest = x.mean(0) + (x - x.mean(0)) / 1.2
+    pins = np.flatnonzero(np.abs(a) > 0.045)
+    for gap in (0.005, 0.002):
+        net = G.network(G.Garment("strip", rest, tris, G.FABRICS["cotton_jersey"],
+                                  {"pinned": pins}), dt=1.0 / 240.0)
+        net.x[:], net.v[:] = x, 0.0
+        assert surface.mesh_distance(net.x[mid])[0].max() < -0.0009
+        net.layers = Layers(net, surface)
+        law = SkinContactParams(final_limits=1, final_gap=gap)
+        proj = _Projector(net, surface.triangles, law, X, surface.vertex_limbs())
+        proj.start()
+        proj.resolve(X, np.zeros_like(X), 1.0 / 240.0)
+        # to round-off of the tangent planes over the skin's facets (0.01 mm)
+        assert surface.mesh_distance(net.x[mid])[0] == pytest.approx(gap, abs=1e-5)
+
+
 def test_the_strain_limit_leaves_a_contact_plane_on_its_outer_side():
     """A strip (in the x-z plane) pinned along both side edges, stretched 20% between them,
     its middle column pushed 2 cm out of the plane by a post: the half-space y >= 0.02 m.

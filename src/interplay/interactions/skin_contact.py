@@ -61,8 +61,8 @@ class SkinContactParams:
     spacing can pass between two points held off it; the runner's garments' pass 15% longer
     and it has no such crossing without it, so off by default; on for the swing's skirt);
     final_gap (m): how near the skin the final limits may bring a point (the thickness if
-    more, as by default; 2 mm with three final limits: the runner's tee at 5.0% at frame 0
-    and the median frame, 5.5-7.2% at the worst, docs/clothing.md)."""
+    more, as by default; 2 mm with two or three final limits: the runner's tee at 5.0% at
+    frame 0 and the median frame, 5.1-5.2% in its one worst frame, docs/clothing.md)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)
     reach: float = param(0.03, "m", gt=0.0, le=0.5)
@@ -193,15 +193,17 @@ class _Projector:
         self.limb[:] = np.where(tri >= 0, self.limbs[self.tris[tri, 0]], -1)
         if self.limiter is not None:
             # each point found near the skin keeps the thickness off its nearest point's
-            # tangent plane: n . x >= n . x_now + thickness - max(s, thickness) (a point
-            # just pushed out stays where it is along n)
+            # tangent plane. Its distance now is what was found, or the thickness where the
+            # projection has just moved it out to that (a point that rides the skin is
+            # not moved by the limit either way)
             near = np.flatnonzero(tri >= 0)
-            planes = kept_off(near, self.n[near], v.x[near], self.s[near], self.p.thickness)
+            now = np.maximum(self.s[near], self.p.thickness)
+            planes = kept_off(near, self.n[near], v.x[near], now, self.p.thickness)
             # the final limits (below) may bring a point nearer, to final_gap: a pleat lying on
             # her chest then flattens towards the skin instead of crossing itself (docs/
             # clothing.md, "The final gap")
             final = (planes if self.p.final_gap >= self.p.thickness else
-                     kept_off(near, self.n[near], v.x[near], self.s[near], self.p.final_gap))
+                     kept_off(near, self.n[near], v.x[near], now, self.p.final_gap))
             before = v.v.copy()
             self.limiter.limit_strain(h, planes)
             # the limit's own velocity changes join the contact's in the reaction: its
