@@ -7,7 +7,7 @@ garments' pass simulated for ``--seconds`` of the clip, ``repeats`` times: outpu
 per-frame certificates, which are timed apart: the same run with the certificates off), the
 vertex counts, and the load average; the same at the issue's target size (10-15k garment
 points: the garments cut at TARGET_SPACING instead of the scene's 0.016 m), and there the
-accurate run's contact (ACCURATE) too, with its ratio to the default's. The issue asks for the
+faster contact (FAST) too, with its ratio to the default's. The issue asks for the
 same garment, body and motion in
 MuJoCo's flex cloth as a peer in the same run: ``peer.mujoco_flex``
 (peer_mujoco_garments.py: the same dressed garments at t = 0 on the segments' primitives
@@ -25,9 +25,10 @@ from dataclasses import replace  # noqa: E402
 from interplay.scenes import runner as RN  # noqa: E402
 
 TARGET_SPACING = 0.014  # m: the tee and pants cut at this give 12.5k points (issue: 10-15k)
-#: the accurate run's contact (docs/clothing.md, "The final gap": the tee at 5.0% at frame 0
-#: and the median frame), timed at the target size beside the default
-ACCURATE = {"final_limits": 3, "final_gap": 0.002}
+#: the faster contact (one final limit, held at the thickness: the tee at 8.7% in its worst
+#: frame against the default's 5.1%; docs/clothing.md, "The final gap"), timed at the target
+#: size beside the default
+FAST = {"final_limits": 1, "final_gap": 0.005}
 
 
 def target_size() -> RN.RunnerParams:
@@ -36,8 +37,8 @@ def target_size() -> RN.RunnerParams:
                    pants=replace(p.pants, spacing=TARGET_SPACING))
 
 
-def accurate(p: RN.RunnerParams) -> RN.RunnerParams:
-    return replace(p, contact=replace(p.contact, **ACCURATE))
+def fast(p: RN.RunnerParams) -> RN.RunnerParams:
+    return replace(p, contact=replace(p.contact, **FAST))
 
 
 def one(seconds: float, certify: bool, params=None) -> tuple[float, dict]:
@@ -72,7 +73,7 @@ def main():
     sizes = {}
     # the target size first: the scene keeps one dressing, and the peer below uses the default
     for size, params in (("target_size", target_size()),
-                         ("target_size_accurate", accurate(target_size())),
+                         ("target_size_fast", fast(target_size())),
                          ("default", RN.RunnerParams())):
         one(0.05, False, params)  # build, cut, dress and compile once: later builds reuse it
         rows = {}
@@ -88,14 +89,14 @@ def main():
                 "frames_per_wall_s": frames / stats(samples)["median"]}
         sizes[size] = {"vertices": meta["vertices"], "spacing_m": params.tee.spacing,
                        "runs": rows}
-    acc, base = sizes["target_size_accurate"]["runs"], sizes["target_size"]["runs"]
+    quick, base = sizes["target_size_fast"]["runs"], sizes["target_size"]["runs"]
     fps = lambda runs, k: runs[k]["frames_per_wall_s"]  # noqa: E731
     out = {"machine": machine(), "seconds": seconds, "vertices": sizes["default"]["vertices"],
            "cloth_dt_s": RN.RunnerParams().cloth_dt, "runs": sizes["default"]["runs"],
            "target_size": sizes["target_size"],
-           "target_size_accurate": {**sizes["target_size_accurate"], "contact": ACCURATE,
-                                    "to_target_size": {k: fps(acc, k) / fps(base, k)
-                                                       for k in acc}},
+           "target_size_fast": {**sizes["target_size_fast"], "contact": FAST,
+                                "to_target_size": {k: fps(quick, k) / fps(base, k)
+                                                   for k in quick}},
            "target_frames_per_wall_s": 1.0,
            "peer": {"mujoco_flex": peer(1.0 / 30.0 if args.quick else args.peer_seconds)}}
     print(write_json(args.out, "bench_runner.json", out))
