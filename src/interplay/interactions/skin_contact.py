@@ -62,7 +62,10 @@ class SkinContactParams:
     and it has no such crossing without it, so off by default; on for the swing's skirt);
     final_gap (m): how near the skin the final limits may bring a point (the thickness if
     more, as by default; 2 mm with two or three final limits: the runner's tee at 5.0% at
-    frame 0 and the median frame, 5.1-5.2% in its one worst frame, docs/clothing.md)."""
+    frame 0 and the median frame, 5.1-5.2% in its one worst frame, docs/clothing.md);
+    relimits: how often the stretch limit and the layers' guard run again after the guard,
+    before the final limits (the runner's tee, two final limits at 2 mm: one frame of 43 at
+    5.1% with one, none over 5% with two; each is a limit and a guard more a step)."""
     thickness: float = param(0.005, "m", gt=0.0, le=0.1)
     friction: float = param(0.5, "-", ge=0.0, le=5.0)
     reach: float = param(0.03, "m", gt=0.0, le=0.5)
@@ -70,6 +73,7 @@ class SkinContactParams:
     final_limits: int = param(1, "passes", ge=0, le=5, doc="0: fastest")
     edges: bool = param(False, doc="edge-edge contact with the skin too")
     final_gap: float = param(0.005, "m", ge=0.0, le=0.1, doc="the thickness if more")
+    relimits: int = param(1, "passes", ge=0, le=5, doc="0: fastest")
 
 
 class PosedSkin:
@@ -100,8 +104,6 @@ class PosedSkin:
         return X + h * V, V
 
 
-#: how often the stretch limit and the layers' guard run again after the guard (see resolve)
-RELIMITS = 1
 #: m: the least a point that rides the skin is kept off it (see resolve)
 RIDE_OFF = 0.001
 
@@ -215,16 +217,16 @@ class _Projector:
             # last: no new crossing of the garments survives the step (its moves are the
             # cloth's own, not the skin's push: they stay out of the reaction). The zones it
             # moves stretch the springs at their rims; the limit then shortens them and the
-            # guard looks again (once: the runner's tee at 95% largest strain without, 32%
-            # with), its zones rigid from the first round: carried by the skin they stretch
-            # within (the tee's worst 31%, 12% rigid; docs/clothing.md)
+            # guard looks again (``relimits`` times: the runner's tee at 95% largest strain
+            # without, 32% with one), its zones rigid from the first round: carried by the
+            # skin they stretch within (the tee's worst 31%, 12% rigid; docs/clothing.md)
             follow = None
             if self.carry:
                 hit = tri >= 0
                 follow = np.full_like(v.x, np.nan)
                 follow[hit] = h * np.einsum("kj,kjd->kd", bary[hit], V[self.tris[tri[hit]]])
             self.layers.guard(self.x0, h, follow)
-            for _ in range(RELIMITS if self.limiter is not None else 0):
+            for _ in range(self.p.relimits if self.limiter is not None else 0):
                 before = v.v.copy()
                 self.limiter.limit_strain(h, planes)
                 self.dv += v.v - before

@@ -53,9 +53,10 @@ DRESS_S = 0.4
 class RunnerParams:
     """clip: a BVH clip in the mocap folder ("" or absent: the keyframed run); clearance: the
     gaps its limbs keep on our body (geometry/clearance.py); skin: the body surface; tee,
-    pants: how each garment is cut; contact: cloth on skin (two final limits that may bring
-    the cloth to 2 mm off the skin: the tee within 5% but in one frame of 43, 5.1%, at 0.94x
-    the speed of one limit at the thickness, whose tee reaches 8.7%; docs/clothing.md);
+    pants: how each garment is cut; contact: cloth on skin (two relimits and two final limits
+    that may bring the cloth to 2 mm off the skin: the tee within 5% in every frame, at
+    about 0.85x the speed of one of each at the thickness, whose tee reaches 8.7%;
+    docs/clothing.md);
     self_thickness (m): the garments' contact skin against themselves (0: no
     self-collision); cloth_dt (s): the cloth's step, which is the coupling step (the skin
     contact resolves every step); lg_iterations: the cloth solver's iterations per step;
@@ -68,7 +69,7 @@ class RunnerParams:
     skin: SurfaceParams = SurfaceParams()
     tee: Fit = Fit(spacing=0.016)
     pants: Fit = replace(PANTS_FIT, spacing=0.016)
-    contact: SkinContactParams = SkinContactParams(final_limits=2, final_gap=0.002)
+    contact: SkinContactParams = SkinContactParams(final_limits=2, final_gap=0.002, relimits=2)
     self_thickness: float = param(0.0, "m", ge=0.0, le=0.05)
     layers: float = param(0.008, "m", ge=0.0, le=0.02, doc="0: the layers not held apart")
     cloth_dt: float = param(1.0 / 240.0, "s", ge=1e-5, le=0.02)
