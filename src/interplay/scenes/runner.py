@@ -55,7 +55,7 @@ class RunnerParams:
     gaps its limbs keep on our body (geometry/clearance.py); skin: the body surface; tee,
     pants: how each garment is cut; contact: cloth on skin (two relimits and two final limits
     that may bring the cloth to 2 mm off the skin: the tee within 5% in every frame, at
-    about 0.85x the speed of one of each at the thickness, whose tee reaches 8.7%;
+    0.78-0.86x the speed of one of each at the thickness, whose tee reaches 8.7%;
     docs/clothing.md);
     self_thickness (m): the garments' contact skin against themselves (0: no
     self-collision); cloth_dt (s): the cloth's step, which is the coupling step (the skin
